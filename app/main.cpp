@@ -1,0 +1,153 @@
+// The `arlequin` command line: run and check case files.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "app/runner.hpp"
+#include "app/scene.hpp"
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+
+namespace {
+
+using namespace arlequin;
+
+constexpr const char* usage_main =
+    "usage: arlequin <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  run CASE.yaml     run a case, write results (series.csv, fields.h5/.xdmf, summary.json)\n"
+    "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
+    "\n"
+    "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
+
+constexpr const char* usage_run =
+    "usage: arlequin run CASE.yaml [--out DIR] [--set key.path=value ...] [--steps N]\n"
+    "  --out DIR      write results to DIR instead of output.dir of the case\n"
+    "  --set k=v      override a case value (YAML syntax), e.g. --set time.end=1e-3\n"
+    "  --steps N      stop after N steps\n"
+    "  --quiet        no progress line\n";
+
+constexpr const char* usage_check =
+    "usage: arlequin check CASE.yaml [--set key.path=value ...]\n"
+    "  prints the case as resolved (with defaults), the DE and bond counts, the critical\n"
+    "  time step and the time step that a run would use\n";
+
+struct Arguments {
+  std::string command;
+  std::string case_file;
+  app::SceneOptions scene;
+  long steps = -1;
+  bool quiet = false;
+  bool help = false;
+};
+
+Arguments parse(int argc, char** argv) {
+  Arguments a;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  static constexpr std::string_view commands[] = {"run", "check"};
+  if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
+  a.command = args[0];
+  if (a.command == "--help" || a.command == "-h") return a.help = true, a;
+  if (a.command == "--version") return a;
+  if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
+    const auto guess = closest_match(a.command, commands);
+    throw InputError("unknown command '" + a.command + "'" +
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check"));
+  }
+  for (std::size_t k = 1; k < args.size(); ++k) {
+    const std::string& arg = args[k];
+    const auto value = [&](const char* what) -> std::string {
+      if (k + 1 >= args.size()) throw InputError(arg + ": expected " + what + " after it");
+      return args[++k];
+    };
+    if (arg == "--help" || arg == "-h") {
+      a.help = true;
+    } else if (arg == "--set") {
+      a.scene.overrides.push_back(value("key.path=value"));
+    } else if (arg.starts_with("--set=")) {
+      a.scene.overrides.push_back(arg.substr(6));
+    } else if (arg == "--out" && a.command == "run") {
+      a.scene.out_dir = value("a directory");
+    } else if (arg == "--steps" && a.command == "run") {
+      const std::string v = value("a number of steps");
+      char* end = nullptr;
+      a.steps = std::strtol(v.c_str(), &end, 10);
+      if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+    } else if (arg == "--quiet" && a.command == "run") {
+      a.quiet = true;
+    } else if (!arg.starts_with("-") && a.case_file.empty()) {
+      a.case_file = arg;
+    } else {
+      throw InputError("arlequin " + a.command + ": unknown option '" + arg + "' (see arlequin " + a.command + " --help)");
+    }
+  }
+  if (!a.help && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
+  return a;
+}
+
+void print_scene_facts(const app::Scene& scene) {
+  const auto& model = scene.dem;
+  std::printf("case: %s\n  DEs: %zu\n", scene.name.c_str(), model.particles.size());
+  for (const auto& set : model.bond_sets()) std::printf("  %s bonds: %zu\n", std::string(set->law()).c_str(), set->size());
+  std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
+  std::printf("  critical time step: %.6e s\n  time step: %.6e s (%.3f of critical)\n  steps: %ld to t = %.6e s\n",
+              scene.dt_critical, scene.dt, scene.dt / scene.dt_critical,
+              static_cast<long>(std::ceil(scene.end_time / scene.dt - 1e-9)), scene.end_time);
+}
+
+int run(const Arguments& a) {
+  const auto t0 = std::chrono::steady_clock::now();
+  app::Scene scene = app::build_scene(a.case_file, a.scene);
+  app::RunOptions options;
+  options.max_steps = a.steps;
+  options.show_progress = !a.quiet && isatty(STDERR_FILENO) && std::getenv("CI") == nullptr;
+  options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  print_scene_facts(scene);
+  const app::RunResult r = app::run_scene(scene, options);
+  std::printf("done: %ld steps, t = %.6e s, wall %.3f s (%.0f steps/s), setup %.3f s\n", r.steps, r.simulated_time,
+              r.wall_seconds, r.steps / std::max(r.wall_seconds, 1e-9), options.setup_seconds);
+  const auto& e = r.energies;
+  std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e\n",
+              e.kinetic, e.bond, e.contact, e.external_work, e.dissipated);
+  for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
+  std::printf("results: %s\n", std::filesystem::absolute(scene.output.dir).string().c_str());
+  return 0;
+}
+
+int check(const Arguments& a) {
+  app::Scene scene = app::build_scene(a.case_file, a.scene);
+  std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
+  print_scene_facts(scene);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Arguments a = parse(argc, argv);
+    if (a.command == "--version") return std::printf("arlequin %s\n", ARLEQUIN_VERSION), 0;
+    if (a.help) {
+      std::fputs(a.command == "run" ? usage_run : a.command == "check" ? usage_check : usage_main, stdout);
+      return 0;
+    }
+    return a.command == "run" ? run(a) : check(a);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "arlequin: error: %s\n", e.what());
+    return 2;
+  } catch (const RunError& e) {
+    std::fprintf(stderr, "arlequin: run stopped: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "arlequin: internal error: %s\n", e.what());
+    return 4;
+  }
+}

@@ -1,0 +1,239 @@
+#include "app/runner.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "common/atomic_file.hpp"
+#include "common/csv_series.hpp"
+#include "common/error.hpp"
+#include "common/fields_writer.hpp"
+#include "common/json.hpp"
+
+namespace arlequin::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+constexpr const char* energy_columns[] = {"E_kinetic", "E_bond", "E_contact", "W_external",
+                                          "E_dissipated", "E_total", "E_balance"};
+
+// Writes the output files of one run; every file is replaced atomically.
+class Outputs {
+ public:
+  Outputs(const Scene& scene) : scene_(scene) {
+    std::filesystem::create_directories(scene.output.dir);
+    std::vector<std::string> columns{"time", "step"};
+    for (auto& c : sensor_columns(scene)) columns.push_back(c);
+    for (const char* c : energy_columns) columns.push_back(c);
+    series_.emplace(scene.output.dir / "series.csv", columns);
+    if (scene.output.particle_fields || scene.output.bond_fields)
+      fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+    write_file_atomically(scene.output.dir / "case.resolved.yaml", scene.resolved_case);
+  }
+
+  // One row of series.csv; returns the sensors' values.
+  std::vector<std::pair<std::string, double>> write_row(const dem::Energies& e, double initial_total) {
+    const dem::DemModel& model = scene_.dem;
+    row_.assign({model.time(), double(model.steps_done())});
+    std::vector<std::pair<std::string, double>> values;
+    const auto names = sensor_columns(scene_);
+    std::size_t column = 0;
+    for (const Sensor& s : scene_.sensors) {
+      const Vec3 v = s.kind == Sensor::Kind::force ? model.reaction_on(s.group) : model.mean_displacement(s.group);
+      for (int k = 0; k < 3; ++k)
+        if (s.component < 0 || s.component == k) {
+          row_.push_back(v[k]);
+          values.emplace_back(names[column++], v[k]);
+        }
+    }
+    const double balance = e.total() + e.dissipated - e.external_work - initial_total;
+    for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.total(), balance})
+      row_.push_back(x);
+    series_->append(row_);
+    return values;
+  }
+
+  void write_fields() {
+    if (!fields_) return;
+    const dem::ParticleSet& p = scene_.dem.particles;
+    fields_->begin_frame(scene_.dem.time());
+    fields_->add_grid("particles", p.position, FieldsWriter::CellKind::Vertex, {});
+    scratch_vec_.resize(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) scratch_vec_[i] = p.position[i] - p.reference[i];
+    fields_->add_point_field("particles", "displacement", scratch_vec_);
+    fields_->add_point_field("particles", "velocity", p.velocity);
+    fields_->add_point_field("particles", "angular_velocity", p.angular_velocity);
+    fields_->add_point_field("particles", "radius", p.radius);
+    scratch_int_.assign(p.groups.begin(), p.groups.end());
+    fields_->add_point_field("particles", "groups", scratch_int_);
+    if (scene_.output.bond_fields && !scene_.dem.bond_sets().empty()) {
+      scratch_lines_.clear();
+      scratch_set_.clear();
+      for (std::size_t s = 0; s < scene_.dem.bond_sets().size(); ++s) {
+        const dem::BondSet& set = *scene_.dem.bond_sets()[s];
+        for (std::size_t b = 0; b < set.size(); ++b) {
+          scratch_lines_.push_back(set.first()[b]);
+          scratch_lines_.push_back(set.second()[b]);
+          scratch_set_.push_back(static_cast<std::int32_t>(s));
+        }
+      }
+      fields_->add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, scratch_lines_);
+      fields_->add_cell_field("bonds", "bond_set", scratch_set_);
+    }
+    fields_->end_frame();
+  }
+
+  void close() {
+    series_->flush();
+    if (fields_) fields_->close();
+  }
+
+ private:
+  const Scene& scene_;
+  std::optional<CsvSeries> series_;
+  std::optional<FieldsWriter> fields_;
+  std::vector<double> row_;
+  std::vector<Vec3> scratch_vec_;
+  std::vector<std::int32_t> scratch_int_, scratch_set_;
+  std::vector<std::int64_t> scratch_lines_;
+};
+
+// A progress line on stderr, at most twice a second: step, simulated time, rate, ETA.
+class Progress {
+ public:
+  Progress(bool enabled, long total) : enabled_(enabled), total_(total), start_(Clock::now()), last_(start_) {}
+  void update(long step, double t) {
+    if (!enabled_ || seconds_since(last_) < 0.5) return;
+    last_ = Clock::now();
+    const double elapsed = seconds_since(start_);
+    const double rate = step / std::max(elapsed, 1e-9);
+    std::fprintf(stderr, "\r  step %ld/%ld  t = %.4e s  %.0f steps/s  ETA %.0f s   ", step, total_, t, rate,
+                 (total_ - step) / std::max(rate, 1e-9));
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (enabled_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool enabled_;
+  long total_;
+  Clock::time_point start_, last_;
+};
+
+Json energies_json(const dem::Energies& e) {
+  Json j = Json::object();
+  j["kinetic"] = e.kinetic;
+  j["bond"] = e.bond;
+  j["contact"] = e.contact;
+  j["external_work"] = e.external_work;
+  j["dissipated"] = e.dissipated;
+  j["total"] = e.total();
+  return j;
+}
+
+}  // namespace
+
+std::vector<std::string> sensor_columns(const Scene& scene) {
+  std::vector<std::string> out;
+  for (const Sensor& s : scene.sensors) {
+    if (s.component >= 0) {
+      out.push_back(s.name);
+    } else {
+      for (const char* axis : {"_x", "_y", "_z"}) out.push_back(s.name + axis);
+    }
+  }
+  return out;
+}
+
+RunResult run_scene(Scene& scene, const RunOptions& options) {
+  dem::DemModel& model = scene.dem;
+  long total_steps = static_cast<long>(std::ceil(scene.end_time / scene.dt - 1e-9));
+  if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
+
+  Outputs outputs(scene);
+  Progress progress(options.show_progress, total_steps);
+  RunResult result;
+  const double initial_total = model.energies().total();
+  // A healthy run's kinetic energy stays below what it started with plus the work put in;
+  // far above that (x100) the run has blown up. The first step's kinetic energy counts
+  // the motion that boundary conditions impose.
+  double energy_scale = std::abs(initial_total);
+  double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
+  // Float steps accumulate round-off: an output is due within a millionth of a step.
+  const double slack = 1e-6 * scene.dt;
+  const auto write_outputs = [&] {
+    const auto t0 = Clock::now();
+    result.energies = model.energies();
+    if (model.time() + slack >= next_row || model.steps_done() == total_steps) {
+      result.sensors = outputs.write_row(result.energies, initial_total);
+      next_row += scene.output.every;
+    }
+    if (model.time() + slack >= next_frame || model.steps_done() == total_steps) {
+      outputs.write_fields();
+      next_frame += scene.output.fields_every;
+    }
+    output_seconds += seconds_since(t0);
+  };
+
+  const auto t_start = Clock::now();
+  std::string failure;
+  try {
+    write_outputs();
+    for (long n = 1; n <= total_steps; ++n) {
+      model.step(scene.dt);
+      if (n == 1) energy_scale = std::max(energy_scale, model.energies().kinetic);
+      if (n % 50 == 0 || n == total_steps) {
+        model.check_health(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
+      }
+      if (model.time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
+      progress.update(n, model.time());
+    }
+  } catch (const RunError& e) {
+    failure = e.what();
+  }
+  progress.finish();
+  result.steps = model.steps_done();
+  result.simulated_time = model.time();
+  result.wall_seconds = seconds_since(t_start);
+  outputs.close();
+
+  Json summary = Json::object();
+  summary["name"] = scene.name;
+  summary["case_file"] = std::filesystem::absolute(scene.case_file).string();
+  summary["version"] = ARLEQUIN_VERSION;
+  summary["status"] = failure.empty() ? "completed" : "failed";
+  if (!failure.empty()) summary["error"] = failure;
+  summary["steps"] = result.steps;
+  summary["simulated_time"] = result.simulated_time;
+  summary["dt"] = scene.dt;
+  summary["dt_critical"] = scene.dt_critical;
+  Json& counts = summary["counts"];
+  counts["particles"] = model.particles.size();
+  for (const auto& set : model.bond_sets()) counts[std::string(set->law()) + "_bonds"] = set->size();
+  if (const auto* list = model.neighbours()) {
+    counts["contact_candidates"] = list->pairs().size();
+    counts["neighbour_rebuilds"] = list->builds();
+  }
+  Json& wall = summary["wall_time"];
+  wall["setup"] = options.setup_seconds;
+  wall["time_loop"] = result.wall_seconds;
+  wall["output"] = output_seconds;
+  wall["steps_per_second"] = result.steps / std::max(result.wall_seconds - output_seconds, 1e-9);
+  summary["energies"] = energies_json(result.energies);
+  Json& sensors = summary["sensors"];
+  sensors = Json::object();
+  for (const auto& [name, value] : result.sensors) sensors[name] = value;
+  write_json_atomically(scene.output.dir / "summary.json", summary);
+  if (!failure.empty()) throw RunError(failure);
+  return result;
+}
+
+}  // namespace arlequin::app

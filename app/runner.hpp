@@ -1,0 +1,34 @@
+// Runs a scene to its end time: the time loop, outputs (series.csv, fields.h5/.xdmf,
+// summary.json in the output folder, each written atomically), progress and health checks.
+//
+// Contract: on success returns the run's figures; on a RunError (NaN, blow-up) the outputs so
+// far are flushed and closed, summary.json records the failure, and the error is rethrown.
+#pragma once
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/scene.hpp"
+
+namespace arlequin::app {
+
+struct RunOptions {
+  long max_steps = -1;         // --steps N: stop after N steps (< 0: run to the end time)
+  bool show_progress = false;  // progress line on stderr (a terminal, not CI)
+  double setup_seconds = 0.0;  // wall time spent building the scene, for the summary
+};
+
+struct RunResult {
+  long steps = 0;
+  double simulated_time = 0.0;  // s
+  double wall_seconds = 0.0;    // time loop only
+  dem::Energies energies;
+  std::vector<std::pair<std::string, double>> sensors;  // last value of each column
+};
+
+RunResult run_scene(Scene& scene, const RunOptions& options);
+
+// Column names of series.csv for the scene's sensors (one, or three for component: all).
+std::vector<std::string> sensor_columns(const Scene& scene);
+
+}  // namespace arlequin::app

@@ -1,0 +1,242 @@
+#include "app/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+#include "common/region.hpp"
+#include "dem/samples.hpp"
+
+namespace arlequin::app {
+namespace {
+
+using dem::BoundaryCondition;
+using dem::BoundaryKind;
+
+constexpr std::string_view component_names[] = {"x", "y", "z", "all"};
+
+void read_sample(CaseNode sample, dem::ParticleSet& p, double density) {
+  static constexpr std::string_view builders[] = {"lattice", "chain", "particles"};
+  const std::string build = sample.choice("build", builders);
+  if (build == "lattice") {
+    const Vec3 origin = sample.vec3_or("origin", {}, Range::any(), "m");
+    const auto counts = sample.numbers("counts", Range::at_least(1), "1");
+    if (counts.size() != 3) sample.fail("counts", "expected three DE counts [nx, ny, nz]");
+    for (double c : counts)
+      if (c != std::floor(c)) sample.fail("counts", "expected whole numbers");
+    const double radius = sample.number("radius", Range::positive(), "m");
+    const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
+    dem::build_lattice(p, origin, {int(counts[0]), int(counts[1]), int(counts[2])}, spacing, radius, density);
+  } else if (build == "chain") {
+    const Vec3 start = sample.vec3_or("start", {}, Range::any(), "m");
+    const Vec3 direction = sample.vec3_or("direction", {1, 0, 0}, Range::any(), "1");
+    if (!(norm(direction) > 0.0)) sample.fail("direction", "expected a non-zero direction vector");
+    const auto count = sample.integer("count", Range::at_least(1));
+    const double radius = sample.number("radius", Range::positive(), "m");
+    const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
+    dem::build_chain(p, start, normalized(direction), int(count), spacing, radius, density);
+  } else {
+    for (CaseNode item : sample.list("particles")) {
+      const Vec3 x = item.vec3("position", Range::any(), "m");
+      const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), density);
+      p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
+      item.finish();
+    }
+  }
+  sample.finish();
+}
+
+void read_bonds(CaseNode bond, dem::DemModel& model) {
+  const double tolerance = bond.number_or("tolerance", 0.01, Range::between(0.0, 1.0), "1");
+  dem::BondSet& set = model.add_bond_set(dem::make_bond_set(bond));
+  bond.finish();
+  for (auto [i, j] : dem::close_pairs(model.particles, tolerance)) set.add(i, j, model.particles);
+  if (set.size() == 0)
+    bond.fail("tolerance", "no pair of DEs is close enough to bond; raise the tolerance or remove 'bond'");
+}
+
+void read_groups(CaseNode root, dem::DemModel& model) {
+  for (CaseNode g : root.list_or_empty("groups")) {
+    const std::string name = g.string("name");
+    if (model.group_index(name) >= 0) g.fail("name", "group '" + name + "' is defined twice");
+    if (model.group_names().size() >= static_cast<std::size_t>(dem::max_groups))
+      g.fail("name", "too many groups (at most 32)");
+    const int index = model.add_group(name);
+    const dem::GroupMask bit = dem::GroupMask{1} << index;
+    dem::ParticleSet& p = model.particles;
+    std::size_t count = 0;
+    if (g.has("ids")) {
+      for (double id : g.numbers("ids", Range::between(0, double(p.size()) - 1), "1")) {
+        if (id != std::floor(id)) g.fail("ids", "expected whole DE indices");
+        p.groups[std::size_t(id)] |= bit, ++count;
+      }
+    } else {
+      CaseNode region_node = g.child("region");
+      const Region region = Region::read(region_node);
+      region_node.finish();
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (region.contains(p.position[i])) p.groups[i] |= bit, ++count;
+    }
+    if (count == 0) g.fail(g.has("ids") ? "ids" : "region", "group '" + name + "' contains no DE");
+    g.finish();
+  }
+}
+
+int group_of(CaseNode& node, const dem::DemModel& model) {
+  const std::string name = node.string("group");
+  const int g = model.group_index(name);
+  if (g < 0) {
+    std::string known;
+    for (const auto& n : model.group_names()) known += (known.empty() ? "" : ", ") + n;
+    node.fail("group", "unknown group '" + name + "' (defined groups: " + (known.empty() ? "none" : known) + ")");
+  }
+  return g;
+}
+
+void read_boundary(CaseNode root, dem::DemModel& model) {
+  static constexpr std::string_view kinds[] = {"fixed", "velocity", "displacement", "force", "free"};
+  static constexpr std::string_view rotations[] = {"free", "fixed"};
+  std::vector<CaseNode> entries = root.list_or_empty("boundary");
+  for (CaseNode b : entries) {
+    BoundaryCondition bc;
+    group_of(b, model);
+    bc.group = b.string("group");
+    const std::string kind = b.choice("type", kinds);
+    if (kind == "fixed") {
+      bc.kind = BoundaryKind::fixed;
+      bc.lock_rotation = true;
+    } else if (kind == "free") {
+      bc.kind = BoundaryKind::free;
+    } else {
+      bc.kind = kind == "velocity" ? BoundaryKind::velocity
+                : kind == "displacement" ? BoundaryKind::displacement : BoundaryKind::force;
+      bc.value = b.vec3("value", Range::any(), kind == "velocity" ? "m/s" : kind == "force" ? "N" : "m");
+      if (bc.kind == BoundaryKind::displacement) bc.ramp = b.number("ramp", Range::positive(), "s");
+      if (bc.kind != BoundaryKind::force) bc.lock_rotation = b.choice_or("rotation", "free", rotations) == "fixed";
+    }
+    b.finish();
+    model.add_boundary(bc);
+  }
+  try {
+    model.finalize();
+  } catch (const std::invalid_argument& e) {
+    if (entries.empty()) throw InputError(root.where() + ": " + e.what());
+    root.fail("boundary", e.what());
+  }
+}
+
+void read_initial(CaseNode root, dem::DemModel& model) {
+  for (CaseNode item : root.list_or_empty("initial")) {
+    const int g = group_of(item, model);
+    const Vec3 v = item.vec3_or("velocity", {}, Range::any(), "m/s");
+    const Vec3 w = item.vec3_or("angular_velocity", {}, Range::any(), "rad/s");
+    item.finish();
+    for (std::uint32_t i : model.members(g)) {
+      model.particles.velocity[i] = v;
+      model.particles.angular_velocity[i] = w;
+    }
+  }
+}
+
+void read_sensors(CaseNode root, Scene& scene) {
+  static constexpr std::string_view types[] = {"force", "displacement"};
+  for (CaseNode s : root.list_or_empty("sensors")) {
+    Sensor sensor;
+    sensor.name = s.string("name");
+    if (sensor.name.empty() || sensor.name.find_first_of(", \"") != std::string::npos)
+      s.fail("name", "expected a non-empty name without commas, quotes or spaces");
+    for (const Sensor& other : scene.sensors)
+      if (other.name == sensor.name) s.fail("name", "sensor '" + sensor.name + "' is defined twice");
+    sensor.kind = s.choice("type", types) == "force" ? Sensor::Kind::force : Sensor::Kind::displacement;
+    sensor.group = group_of(s, scene.dem);
+    const std::string c = s.choice_or("component", "all", component_names);
+    sensor.component = c == "all" ? -1 : c[0] - 'x';
+    s.finish();
+    if (sensor.kind == Sensor::Kind::force) scene.dem.watch_reaction(sensor.group);
+    scene.sensors.push_back(sensor);
+  }
+}
+
+void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& options) {
+  static constexpr std::string_view field_kinds[] = {"particles", "bonds"};
+  OutputPlan& plan = scene.output;
+  plan.dir = "results/" + scene.name;
+  plan.every = scene.end_time / 100.0;
+  if (out) {
+    plan.dir = out->string_or("dir", plan.dir.string());
+    plan.every = out->number_or("every", plan.every, Range::positive(), "s");
+    for (const std::string& f : out->strings_or("fields", {})) {
+      if (std::find(std::begin(field_kinds), std::end(field_kinds), f) == std::end(field_kinds))
+        out->fail("fields", "unknown field set '" + f + "' (expected particles, bonds)");
+      (f == "particles" ? plan.particle_fields : plan.bond_fields) = true;
+    }
+    plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
+    out->finish();
+  }
+  if (!options.out_dir.empty()) plan.dir = options.out_dir;
+}
+
+}  // namespace
+
+Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options) {
+  CaseFile file = CaseFile::load(case_file, options.overrides);
+  CaseNode root = file.root();
+  Scene scene;
+  scene.case_file = case_file;
+  scene.name = root.string_or("name", case_file.parent_path().filename().string());
+  static constexpr std::string_view unit_systems[] = {"SI"};
+  root.choice_or("units", "SI", unit_systems);
+
+  CaseNode time = root.child("time");
+  scene.end_time = time.number("end", Range::positive(), "s");
+  const std::optional<double> user_dt = time.number_or_auto("dt", Range::positive(), "s");
+  scene.safety = time.number_or("safety", 0.3, Range::open_between(0.0, 1.0), "1");
+  time.finish();
+
+  CaseNode dem_node = root.child("dem");
+  dem::DemModel& model = scene.dem;
+  const double density = dem_node.number("density", Range::positive(), "kg/m^3");
+  read_sample(dem_node.child("sample"), model.particles, density);
+  if (auto bond = dem_node.child_if("bond")) read_bonds(*bond, model);
+  if (auto contact = dem_node.child_if("contact")) {
+    double mean_radius = 0.0;
+    for (double r : model.particles.radius) mean_radius += r;
+    mean_radius /= double(model.particles.size());
+    const double skin = contact->number_or("skin", 0.2 * mean_radius, Range::positive(), "m");
+    model.set_contact(dem::make_contact_law(*contact), skin);
+    contact->finish();
+  }
+  model.set_damping(dem_node.number_or("damping", 0.0, Range::non_negative(), "1/s"));
+  dem_node.finish();
+
+  read_groups(root, model);
+  read_initial(root, model);
+  read_sensors(root, scene);
+  read_boundary(root, model);
+
+  scene.dt_critical = model.critical_time_step();
+  if (user_dt) {
+    if (*user_dt > scene.dt_critical) {
+      std::ostringstream msg;
+      msg << "time step " << *user_dt << " s is above the critical time step " << scene.dt_critical
+          << " s (2/omega_max over bonds and contacts); use dt <= " << scene.dt_critical << " or dt: auto";
+      time.fail("dt", msg.str());
+    }
+    scene.dt = *user_dt;
+  } else {
+    if (!std::isfinite(scene.dt_critical))
+      time.fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
+    scene.dt = scene.safety * scene.dt_critical;
+  }
+  read_output(root.child_if("output"), scene, options);
+  root.finish();
+  scene.resolved_case = file.resolved_yaml();
+  return scene;
+}
+
+}  // namespace arlequin::app

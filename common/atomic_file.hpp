@@ -1,0 +1,19 @@
+// Whole-file writes that readers never see half done: outputs are re-written while a run
+// is going (CSV series, XDMF index, summaries) and may be opened by a viewer or a script
+// at any moment, or left behind by a killed run.
+#pragma once
+#include <filesystem>
+#include <string_view>
+
+namespace arlequin {
+
+// The sibling file a new version of `path` is written to before it replaces `path`:
+// `path` + ".tmp". Same directory, so the final rename never crosses file systems.
+std::filesystem::path temporary_path_for(const std::filesystem::path& path);
+
+// Writes `content` to temporary_path_for(path), closes it, then renames it over `path`
+// (atomic on POSIX: readers see the old or the new file, never a mix). Creates missing
+// parent directories. Throws RunError naming the path and the system error.
+void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+
+}  // namespace arlequin

@@ -1,0 +1,668 @@
+#include "common/case_file.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace arlequin {
+
+namespace detail {
+
+// One node of the resolved document. Map records also carry the schema bookkeeping of the
+// document mapping they mirror (which keys were asked for), because both are keyed by the
+// same path and a section read twice must see the same record.
+struct CaseRecord {
+  enum class Kind { Map, List, Plain, Text } kind = Kind::Map;  // Text may need quotes
+  std::string text;                                              // Plain/Text leaves
+  std::vector<std::pair<std::string, std::unique_ptr<CaseRecord>>> entries;  // Map
+  std::vector<std::unique_ptr<CaseRecord>> items;                            // List
+  std::vector<std::string> known;  // keys asked for by accessors: the valid keys
+  std::vector<std::string> named;  // user-chosen names read by child_named
+  bool any_keys = false;
+
+  // The record of `key`, replaced by a fresh one of `kind` unless it already is one
+  // (keeps a section's place and bookkeeping when it is read again).
+  CaseRecord& slot(std::string_view key, Kind k) {
+    auto it = std::find_if(entries.begin(), entries.end(), [&](auto& e) { return e.first == key; });
+    if (it == entries.end()) it = entries.insert(entries.end(), {std::string(key), nullptr});
+    if (!it->second || it->second->kind != k || k == Kind::List) {
+      it->second = std::make_unique<CaseRecord>();
+      it->second->kind = k;
+    }
+    return *it->second;
+  }
+  void put(std::string_view key, Kind k, std::string value) { slot(key, k).text = std::move(value); }
+  void put_list(std::string_view key, Kind k, const std::vector<std::string>& values) {
+    CaseRecord& list = slot(key, Kind::List);
+    for (const auto& v : values) {
+      list.items.push_back(std::make_unique<CaseRecord>());
+      list.items.back()->kind = k;
+      list.items.back()->text = v;
+    }
+  }
+};
+
+struct CaseState {
+  std::filesystem::path file;    // as given by the user: messages show it like that
+  std::filesystem::path folder;  // absolute; relative paths in the case are resolved here
+  YAML::Node doc;
+  // Views refer to their mapping by index: assigning a YAML::Node rebinds the node it
+  // shares data with, so views never hold one themselves (that makes CaseNode assignable).
+  std::vector<YAML::Node> nodes;
+  std::vector<std::pair<std::string, std::string>> overrides;  // key path -> "--set ..." text
+  CaseRecord resolved;
+
+  // "--set ..." if an override provided `path` (or a mapping above it), else "file:line".
+  std::string location(std::string_view path, int line) const {
+    const std::string* best = nullptr;
+    std::size_t best_len = 0;
+    for (const auto& [prefix, text] : overrides) {
+      const bool covers = path.starts_with(prefix) &&
+                          (path.size() == prefix.size() || path[prefix.size()] == '.' ||
+                           path[prefix.size()] == '[');
+      if (covers && prefix.size() >= best_len) best = &text, best_len = prefix.size();
+    }
+    if (best) return *best;
+    return file.string() + (line > 0 ? ":" + std::to_string(line) : "");
+  }
+};
+
+}  // namespace detail
+
+using detail::CaseRecord;
+using Kind = CaseRecord::Kind;
+
+namespace {
+
+// The one place that formats input errors: "<where>: <key path>: <message>".
+[[noreturn]] void raise(std::string_view where, std::string_view path, std::string_view message) {
+  std::string text(where);
+  if (!path.empty()) (text += ": ") += path;
+  (text += ": ") += message;
+  throw InputError(text);
+}
+
+std::string format_number(double v) {
+  char buf[32];
+  return {buf, std::to_chars(buf, buf + sizeof buf, v).ptr};
+}
+
+std::string unit_text(std::string_view unit) {
+  return unit.empty() || unit == "1" ? "" : " [" + std::string(unit) + "]";
+}
+
+// "a number > 0 [m]", "an integer >= 1", "a list of 3 numbers [m]".
+std::string number_text(std::string_view noun, Range range, std::string_view unit) {
+  std::string r = range.describe();
+  return std::string(noun) + (r.empty() ? "" : " " + r) + unit_text(unit);
+}
+
+// A finite number written as a plain YAML scalar; `used` tells how much text a number
+// prefix covered, so "1 mm" can be told apart from "abc".
+std::optional<double> parse_number(std::string_view s, std::size_t* used = nullptr) {
+  if (s.starts_with('+')) s.remove_prefix(1);
+  double v = 0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (used) *used = ec == std::errc() ? std::size_t(end - s.data()) : 0;
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::optional<double> parse_number(const YAML::Node& n) {
+  return n.IsScalar() ? parse_number(n.Scalar()) : std::nullopt;
+}
+
+// What a value is, for "got ..." (kept to one short line).
+std::string describe(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "nothing";
+  if (n.IsMap()) return "a mapping";
+  if (n.IsSequence()) return "a list of " + std::to_string(n.size()) + " items";
+  if (parse_number(n)) return n.Scalar();
+  std::string s = n.Scalar();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  return "'" + s + "'";
+}
+
+std::string joined(const auto& words) {
+  std::string out;
+  for (const auto& w : words) (out += out.empty() ? "" : ", ") += w;
+  return out;
+}
+
+// Strings that a YAML reader would take for another type are quoted in resolved output.
+bool looks_typed(const std::string& s) {
+  static constexpr std::string_view words[] = {"true", "false", "True", "False", "TRUE", "FALSE",
+                                               "null", "Null", "NULL", "~", "auto", ""};
+  return parse_number(s) || std::find(std::begin(words), std::end(words), s) != std::end(words);
+}
+
+void emit(YAML::Emitter& out, const CaseRecord& r) {
+  switch (r.kind) {
+    case Kind::Plain: out << r.text; break;
+    case Kind::Text:
+      if (looks_typed(r.text)) out << YAML::DoubleQuoted;
+      out << r.text;
+      break;
+    case Kind::Map:
+      out << YAML::BeginMap;
+      for (const auto& [key, value] : r.entries) {
+        out << YAML::Key << key << YAML::Value;
+        emit(out, *value);
+      }
+      out << YAML::EndMap;
+      break;
+    case Kind::List: {
+      // Lists of scalars (vectors, field names) read best on one line.
+      const bool flat = std::all_of(r.items.begin(), r.items.end(),
+                                    [](auto& i) { return i->kind != Kind::Map; });
+      if (flat) out << YAML::Flow;
+      out << YAML::BeginSeq;
+      for (const auto& item : r.items) emit(out, *item);
+      out << YAML::EndSeq;
+      break;
+    }
+  }
+}
+
+int line_of(const YAML::Node& n) { return n.Mark().is_null() ? 0 : n.Mark().line + 1; }
+
+std::string read_text(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    raise(file.string(), "", "cannot open case file (" + std::string(std::strerror(EISDIR)) + ")");
+  std::ifstream in(file);
+  if (!in) raise(file.string(), "", "cannot open case file (" + std::string(std::strerror(errno)) + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Applies one "--set a.b.c=value": replaces or creates the key, creating mappings on the way.
+void apply_override(detail::CaseState& s, const std::string& text) {
+  const std::string where = "--set " + text;
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) raise(where, "", "expected --set key.path=value");
+  std::vector<std::string> keys;
+  std::string path = text.substr(0, eq);
+  std::erase_if(path, [](char c) { return std::isspace(static_cast<unsigned char>(c)); });
+  for (std::size_t start = 0;;) {
+    const auto dot = path.find('.', start);
+    keys.push_back(path.substr(start, dot - start));
+    if (keys.back().empty()) raise(where, "", "empty key in '" + path + "'");
+    if (dot == std::string::npos) break;
+    start = dot + 1;
+  }
+  const YAML::Node value = [&] {
+    try {
+      return YAML::Load(text.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      raise(where, "", "YAML syntax error in value: " + e.msg);
+    }
+  }();
+
+  if (s.doc.IsNull()) s.doc.reset(YAML::Node(YAML::NodeType::Map));
+  YAML::Node map;
+  map.reset(s.doc);
+  std::string at;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    at += (i ? "." : "") + keys[i];
+    if (i + 1 == keys.size()) break;
+    const YAML::Node next = map[keys[i]];
+    if (!next.IsDefined() || next.IsNull()) {
+      map[keys[i]] = YAML::Node(YAML::NodeType::Map);
+      s.overrides.emplace_back(at, where);  // the new mapping and everything in it came from here
+    } else if (!next.IsMap()) {
+      raise(where, "", "'" + at + "' is " + describe(next) + ", not a mapping");
+    }
+    const YAML::Node inner = map[keys[i]];
+    map.reset(inner);
+  }
+  map[keys.back()] = value;
+  s.overrides.emplace_back(at, where);
+}
+
+}  // namespace
+
+// ---- Range, edit distance --------------------------------------------------------------
+
+bool Range::contains(double v) const {
+  return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+}
+
+std::string Range::describe() const {
+  const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
+  if (has_lo && has_hi)
+    return std::string("in ") + (lo_open ? "(" : "[") + format_number(lo) + ", " + format_number(hi) +
+           (hi_open ? ")" : "]");
+  if (has_lo) return (lo_open ? "> " : ">= ") + format_number(lo);
+  if (has_hi) return (hi_open ? "< " : "<= ") + format_number(hi);
+  return "";
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);  // distances from a[0..i) to every prefix of b
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+std::optional<std::string_view> closest_match(std::string_view word,
+                                              std::span<const std::string_view> candidates) {
+  std::optional<std::string_view> best;
+  std::size_t best_distance = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (auto c : candidates) {
+    const std::size_t d = edit_distance(word, c);
+    if (d < best_distance) best = c, best_distance = d;
+  }
+  return best;
+}
+
+// ---- CaseNode ------------------------------------------------------------------------
+
+struct CaseNode::Entry {
+  YAML::Node value;  // undefined when the key is absent
+  std::string path;  // "dem.sample.radius", "dem.gravity[2]"
+  int line = 0;      // 1-based line of the key or list item; 0 if unknown
+  bool present() const { return value.IsDefined(); }
+};
+
+CaseNode::CaseNode(std::shared_ptr<detail::CaseState> state, std::size_t index, std::string path,
+                   int line, detail::CaseRecord* record)
+    : state_(std::move(state)), index_(index), path_(std::move(path)), line_(line), record_(record) {}
+
+// A view on a mapping value; an empty value counts as an empty mapping. Keys are checked
+// here once: yaml-cpp accepts duplicate keys and would silently use the first.
+CaseNode CaseNode::open(const std::shared_ptr<detail::CaseState>& state, const Entry& e,
+                        detail::CaseRecord& record) {
+  CaseNode node(state, state->nodes.size(), e.path, e.line, &record);
+  if (!e.value.IsMap() && !e.value.IsNull()) node.mismatch(e, "a mapping");
+  state->nodes.push_back(e.value);
+  std::vector<std::pair<std::string, int>> seen;
+  for (const auto& kv : e.value.IsMap() ? e.value : YAML::Node(YAML::NodeType::Map)) {
+    const int line = line_of(kv.first);
+    if (!kv.first.IsScalar()) raise(state->location(e.path, line), e.path, "keys must be plain names");
+    const std::string& key = kv.first.Scalar();
+    auto it = std::find_if(seen.begin(), seen.end(), [&](auto& s) { return s.first == key; });
+    if (it != seen.end())
+      raise(state->location(node.key_path(key), line), node.key_path(key),
+            "duplicate key (first given at line " + std::to_string(it->second) + ")");
+    seen.emplace_back(key, line);
+  }
+  return node;
+}
+
+CaseNode::Entry CaseNode::find(std::string_view key) const {
+  const YAML::Node& map = state_->nodes[index_];
+  if (map.IsMap())
+    for (const auto& kv : map)
+      if (kv.first.Scalar() == key) return {kv.second, key_path(key), line_of(kv.first)};
+  return {YAML::Node(YAML::NodeType::Undefined), key_path(key), 0};
+}
+
+CaseNode::Entry CaseNode::lookup(std::string_view key) {
+  auto& known = record_->known;
+  if (std::find(known.begin(), known.end(), key) == known.end()) known.emplace_back(key);
+  return find(key);
+}
+
+std::string CaseNode::where() const { return state_->location(path_, line_); }
+std::string CaseNode::where(const Entry& e) const { return state_->location(e.path, e.line); }
+
+std::string CaseNode::key_path(std::string_view key) const {
+  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+}
+
+void CaseNode::fail(std::string_view key, std::string_view message) const {
+  const Entry e = find(key);
+  raise(e.present() ? where(e) : where(), e.path, message);
+}
+
+void CaseNode::missing(std::string_view key, std::string_view expected) const {
+  raise(where(), path_, "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")");
+}
+
+void CaseNode::mismatch(const Entry& e, std::string_view expected) const {
+  raise(where(e), e.path, "expected " + std::string(expected) + ", got " + describe(e.value));
+}
+
+double CaseNode::to_number(const Entry& e, Range range, std::string_view unit, bool integer) const {
+  std::string expected = number_text(integer ? "an integer" : "a number", range, unit);
+  std::size_t used = 0;
+  const auto v = e.value.IsScalar() ? parse_number(e.value.Scalar(), &used) : std::nullopt;
+  if (!v && used > 0) expected += " (SI units, no unit suffix)";  // "1 mm", "200GPa"
+  // Integers beyond 2^53 cannot be told apart from their neighbours as doubles.
+  if (!v || !range.contains(*v) || (integer && (std::trunc(*v) != *v || std::abs(*v) > 0x1p53)))
+    mismatch(e, expected);
+  return *v;
+}
+
+std::string CaseNode::to_string(const Entry& e) const {
+  if (!e.value.IsScalar()) mismatch(e, "a string");
+  return e.value.Scalar();
+}
+
+std::vector<CaseNode::Entry> CaseNode::elements(const Entry& list, std::string_view expected) const {
+  if (list.value.IsNull()) return {};
+  if (!list.value.IsSequence()) mismatch(list, expected);
+  std::vector<Entry> out;
+  for (const auto& item : list.value)
+    out.push_back({item, list.path + "[" + std::to_string(out.size()) + "]", line_of(item)});
+  return out;
+}
+
+double CaseNode::number(std::string_view key, Range range, std::string_view unit) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, number_text("a number", range, unit));
+  const double v = to_number(e, range, unit, false);
+  record_->put(key, Kind::Plain, format_number(v));
+  return v;
+}
+
+double CaseNode::number_or(std::string_view key, double fallback, Range range, std::string_view unit) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put(key, Kind::Plain, format_number(fallback));
+    return fallback;
+  }
+  return number(key, range, unit);
+}
+
+std::optional<double> CaseNode::number_or_auto(std::string_view key, Range range, std::string_view unit) {
+  const Entry e = lookup(key);
+  if (!e.present() || (e.value.IsScalar() && e.value.Scalar() == "auto")) {
+    record_->put(key, Kind::Plain, "auto");
+    return std::nullopt;
+  }
+  if (!parse_number(e.value)) mismatch(e, number_text("a number", range, unit) + " or 'auto'");
+  return number(key, range, unit);
+}
+
+long long CaseNode::integer(std::string_view key, Range range) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, number_text("an integer", range, ""));
+  const auto v = static_cast<long long>(to_number(e, range, "", true));
+  record_->put(key, Kind::Plain, std::to_string(v));
+  return v;
+}
+
+long long CaseNode::integer_or(std::string_view key, long long fallback, Range range) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put(key, Kind::Plain, std::to_string(fallback));
+    return fallback;
+  }
+  return integer(key, range);
+}
+
+bool CaseNode::boolean(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "true or false");
+  // Only true/false: YAML 1.1 also reads yes/no/on/off, a common source of surprises.
+  static constexpr std::string_view yes[] = {"true", "True", "TRUE"}, no[] = {"false", "False", "FALSE"};
+  const std::string s = e.value.IsScalar() ? e.value.Scalar() : "";
+  const bool t = std::find(std::begin(yes), std::end(yes), s) != std::end(yes);
+  if (!t && std::find(std::begin(no), std::end(no), s) == std::end(no)) mismatch(e, "true or false");
+  record_->put(key, Kind::Plain, t ? "true" : "false");
+  return t;
+}
+
+bool CaseNode::boolean_or(std::string_view key, bool fallback) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put(key, Kind::Plain, fallback ? "true" : "false");
+    return fallback;
+  }
+  return boolean(key);
+}
+
+std::string CaseNode::string(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "a string");
+  std::string s = to_string(e);
+  record_->put(key, Kind::Text, s);
+  return s;
+}
+
+std::string CaseNode::string_or(std::string_view key, std::string_view fallback) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put(key, Kind::Text, std::string(fallback));
+    return std::string(fallback);
+  }
+  return string(key);
+}
+
+std::string CaseNode::choice(std::string_view key, std::span<const std::string_view> allowed) {
+  const std::string expected = "one of " + joined(allowed);
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, expected);
+  if (!e.value.IsScalar()) mismatch(e, expected);
+  const std::string s = e.value.Scalar();
+  if (std::find(allowed.begin(), allowed.end(), s) == allowed.end()) {
+    const auto hint = closest_match(s, allowed);
+    raise(where(e), e.path,
+          "expected " + expected + ", got " + describe(e.value) +
+              (hint ? "; did you mean '" + std::string(*hint) + "'?" : ""));
+  }
+  record_->put(key, Kind::Text, s);
+  return s;
+}
+
+std::string CaseNode::choice_or(std::string_view key, std::string_view fallback,
+                                std::span<const std::string_view> allowed) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put(key, Kind::Text, std::string(fallback));
+    return std::string(fallback);
+  }
+  return choice(key, allowed);
+}
+
+Vec3 CaseNode::vec3(std::string_view key, Range each, std::string_view unit) {
+  const std::string expected = number_text("a list of 3 numbers", each, unit);
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, expected);
+  const auto items = elements(e, expected);
+  if (items.size() != 3) mismatch(e, expected);
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = to_number(items[k], each, unit, false);
+  record_->put_list(key, Kind::Plain, {format_number(v.x), format_number(v.y), format_number(v.z)});
+  return v;
+}
+
+Vec3 CaseNode::vec3_or(std::string_view key, Vec3 fallback, Range each, std::string_view unit) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put_list(key, Kind::Plain,
+                      {format_number(fallback.x), format_number(fallback.y), format_number(fallback.z)});
+    return fallback;
+  }
+  return vec3(key, each, unit);
+}
+
+std::vector<double> CaseNode::numbers(std::string_view key, Range each, std::string_view unit) {
+  const std::string expected = number_text("a list of numbers", each, unit);
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, expected);
+  std::vector<double> out;
+  std::vector<std::string> texts;
+  for (const auto& item : elements(e, expected)) {
+    out.push_back(to_number(item, each, unit, false));
+    texts.push_back(format_number(out.back()));
+  }
+  record_->put_list(key, Kind::Plain, texts);
+  return out;
+}
+
+std::vector<Vec3> CaseNode::vec3_list(std::string_view key, Range each, std::string_view unit) {
+  const std::string expected = number_text("a list of [x, y, z] triples", each, unit);
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, expected);
+  std::vector<Vec3> out;
+  std::vector<std::string> texts;
+  for (const auto& item : elements(e, expected)) {
+    const auto xyz = elements(item, expected);
+    if (xyz.size() != 3) mismatch(item, expected);
+    Vec3 v;
+    for (int k = 0; k < 3; ++k) v[k] = to_number(xyz[k], each, unit, false);
+    out.push_back(v);
+    texts.push_back("[" + format_number(v.x) + ", " + format_number(v.y) + ", " + format_number(v.z) + "]");
+  }
+  record_->put_list(key, Kind::Plain, texts);
+  return out;
+}
+
+std::vector<std::string> CaseNode::strings(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "a list of strings");
+  std::vector<std::string> out;
+  for (const auto& item : elements(e, "a list of strings")) out.push_back(to_string(item));
+  record_->put_list(key, Kind::Text, out);
+  return out;
+}
+
+std::vector<std::string> CaseNode::strings_or(std::string_view key, const std::vector<std::string>& fallback) {
+  if (!find(key).present()) {
+    lookup(key);
+    record_->put_list(key, Kind::Text, fallback);
+    return fallback;
+  }
+  return strings(key);
+}
+
+std::filesystem::path CaseNode::existing_file(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "a file path");
+  const std::string text = to_string(e);
+  const std::filesystem::path given(text);
+  const auto file = (given.is_absolute() ? given : state_->folder / given).lexically_normal();
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec))
+    raise(where(e), e.path,
+          "file '" + text + "' not found (looked in " + file.parent_path().string() + ")");
+  if (std::filesystem::is_directory(file, ec)) raise(where(e), e.path, "'" + text + "' is a folder, expected a file");
+  record_->put(key, Kind::Text, file.string());
+  return file;
+}
+
+CaseNode CaseNode::child(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "a mapping");
+  return open(state_, e, record_->slot(key, Kind::Map));
+}
+
+std::optional<CaseNode> CaseNode::child_if(std::string_view key) {
+  if (!lookup(key).present()) return std::nullopt;
+  return child(key);
+}
+
+bool CaseNode::has(std::string_view key) { return lookup(key).present(); }
+
+CaseNode CaseNode::child_named(std::string_view name) {
+  const Entry e = find(name);
+  if (!e.present()) missing(name, "a mapping");
+  if (std::find(record_->named.begin(), record_->named.end(), name) == record_->named.end())
+    record_->named.emplace_back(name);
+  return open(state_, e, record_->slot(name, Kind::Map));
+}
+
+std::vector<CaseNode> CaseNode::items(const Entry& list, std::string_view key) {
+  const auto entries = elements(list, "a list of mappings");
+  CaseRecord& out = record_->slot(key, Kind::List);
+  std::vector<CaseNode> nodes;
+  for (const auto& item : entries) {
+    out.items.push_back(std::make_unique<CaseRecord>());
+    nodes.push_back(open(state_, item, *out.items.back()));
+  }
+  return nodes;
+}
+
+std::vector<CaseNode> CaseNode::list(std::string_view key) {
+  const Entry e = lookup(key);
+  if (!e.present()) missing(key, "a list of mappings");
+  return items(e, key);
+}
+
+std::vector<CaseNode> CaseNode::list_or_empty(std::string_view key) {
+  const Entry e = lookup(key);
+  return items(e.present() ? e : Entry{YAML::Node(YAML::NodeType::Null), e.path, 0}, key);
+}
+
+std::vector<std::string> CaseNode::keys() const {
+  std::vector<std::string> out;
+  const YAML::Node& map = state_->nodes[index_];
+  if (map.IsMap())
+    for (const auto& kv : map) out.push_back(kv.first.Scalar());
+  return out;
+}
+
+void CaseNode::accept_any_keys() { record_->any_keys = true; }
+
+void CaseNode::finish() const {
+  if (record_->any_keys) return;
+  const auto& known = record_->known;
+  const auto& named = record_->named;
+  for (const auto& key : keys()) {
+    if (std::find(known.begin(), known.end(), key) != known.end() ||
+        std::find(named.begin(), named.end(), key) != named.end())
+      continue;
+    const std::vector<std::string_view> valid(known.begin(), known.end());
+    const auto hint = closest_match(key, valid);
+    raise(where(find(key)), key_path(key),
+          hint         ? "unknown key; did you mean '" + std::string(*hint) + "'?"
+          : valid.empty() ? std::string("unknown key; no keys are expected here")
+                          : "unknown key; valid keys: " + joined(valid));
+  }
+}
+
+// ---- CaseFile ------------------------------------------------------------------------
+
+CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  auto state = std::make_shared<detail::CaseState>();
+  state->file = file;
+  state->folder = std::filesystem::absolute(file).lexically_normal().parent_path();
+  const std::string text = read_text(file);
+  try {
+    state->doc.reset(YAML::Load(text));
+  } catch (const YAML::Exception& e) {
+    raise(state->location("", e.mark.is_null() ? 0 : e.mark.line + 1), "", "YAML syntax error: " + e.msg);
+  }
+  if (!state->doc.IsMap() && !state->doc.IsNull())
+    raise(state->location("", line_of(state->doc)), "",
+          "expected a mapping of sections at the top level, got " + describe(state->doc));
+  for (const auto& o : overrides) apply_override(*state, o);
+  return CaseFile(std::move(state));
+}
+
+CaseNode CaseFile::root() {
+  return CaseNode::open(state_, CaseNode::Entry{state_->doc, "", 1}, state_->resolved);
+}
+
+std::string CaseFile::resolved_yaml() const {
+  YAML::Emitter out;
+  out.SetIndent(2);
+  emit(out, state_->resolved);
+  return std::string(out.c_str()) + "\n";
+}
+
+const std::filesystem::path& CaseFile::path() const { return state_->file; }
+
+}  // namespace arlequin

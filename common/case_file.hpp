@@ -1,0 +1,148 @@
+// Case files: the user's YAML description of a simulation, read through a strict schema.
+//
+// Readers pull values through CaseNode accessors that state the type, allowed range and
+// unit of each key, so the schema lives next to the code that uses it. Every accessor
+// records the key as known; finish() then rejects any key the reader never asked for,
+// which catches typos that would otherwise silently fall back to defaults. Every error is
+// one line naming where (file:line, or the --set text that provided the value), the key
+// path and what was expected. Everything read, defaults included, is mirrored into a
+// resolved document that `arlequin check` prints.
+#pragma once
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/vec3.hpp"
+
+namespace arlequin {
+
+// Allowed values of a number, with a text for messages ("> 0", "in [0, 1]").
+struct Range {
+  static constexpr double inf = std::numeric_limits<double>::infinity();
+  double lo = -inf, hi = inf;
+  bool lo_open = false, hi_open = false;
+
+  static Range any() { return {}; }
+  static Range positive() { return {0.0, inf, true, false}; }
+  static Range non_negative() { return at_least(0.0); }
+  static Range at_least(double lo) { return {lo, inf, false, false}; }
+  static Range between(double lo, double hi) { return {lo, hi, false, false}; }
+  static Range open_between(double lo, double hi) { return {lo, hi, true, true}; }
+
+  bool contains(double v) const;
+  std::string describe() const;  // "" for any()
+};
+
+// Levenshtein distance (insertions, deletions, substitutions).
+std::size_t edit_distance(std::string_view a, std::string_view b);
+
+// The candidate closest to `word` if it is close enough to be a likely typo
+// (distance <= max(2, word.size() / 3)); used for "did you mean ...?" hints.
+std::optional<std::string_view> closest_match(std::string_view word,
+                                              std::span<const std::string_view> candidates);
+
+namespace detail {
+struct CaseState;
+struct CaseRecord;
+}  // namespace detail
+
+// A view on one mapping of a case document (a section, or an item of a list of mappings).
+// Cheap to copy; all views of one CaseFile share its state.
+class CaseNode {
+ public:
+  // Numbers are plain SI values; `unit` is only shown in messages ("m" -> "[m]";
+  // "" or "1" for dimensionless shows nothing).
+  double number(std::string_view key, Range range, std::string_view unit);
+  double number_or(std::string_view key, double fallback, Range range, std::string_view unit);
+  // A number or the word `auto` (nullopt); a missing key means auto.
+  std::optional<double> number_or_auto(std::string_view key, Range range, std::string_view unit);
+  long long integer(std::string_view key, Range range);
+  long long integer_or(std::string_view key, long long fallback, Range range);
+  bool boolean(std::string_view key);
+  bool boolean_or(std::string_view key, bool fallback);
+  std::string string(std::string_view key);
+  std::string string_or(std::string_view key, std::string_view fallback);
+  std::string choice(std::string_view key, std::span<const std::string_view> allowed);
+  std::string choice_or(std::string_view key, std::string_view fallback,
+                        std::span<const std::string_view> allowed);
+  Vec3 vec3(std::string_view key, Range each, std::string_view unit);
+  Vec3 vec3_or(std::string_view key, Vec3 fallback, Range each, std::string_view unit);
+  std::vector<double> numbers(std::string_view key, Range each, std::string_view unit);
+  // A list of [x, y, z] triples, e.g. box corners [[x0,y0,z0],[x1,y1,z1]].
+  std::vector<Vec3> vec3_list(std::string_view key, Range each, std::string_view unit);
+  std::vector<std::string> strings(std::string_view key);
+  std::vector<std::string> strings_or(std::string_view key, const std::vector<std::string>& fallback);
+  // A path relative to the case file's folder (or absolute) that must name an existing file.
+  std::filesystem::path existing_file(std::string_view key);
+
+  // Sub-mappings. An empty value (`output:` with nothing after it) is an empty mapping/list.
+  CaseNode child(std::string_view key);
+  std::optional<CaseNode> child_if(std::string_view key);
+  bool has(std::string_view key);  // also records the key as known
+  std::vector<CaseNode> list(std::string_view key);  // items get paths like "loads[2]"
+  std::vector<CaseNode> list_or_empty(std::string_view key);
+
+  // Mappings whose keys are user-chosen names (materials: {fibre: ..., matrix: ...}).
+  std::vector<std::string> keys() const;  // in file order
+  CaseNode child_named(std::string_view name);  // known, but never offered as a suggestion
+  void accept_any_keys();
+
+  std::string where() const;  // "case.yaml:12" or "--set a.b=1"
+  const std::string& path() const { return path_; }  // "dem.sample"; "" for the top level
+  std::string key_path(std::string_view key) const;
+  // Throws InputError "<where of key>: <path.key>: <message>" (semantic checks by callers).
+  [[noreturn]] void fail(std::string_view key, std::string_view message) const;
+
+  // Rejects keys present in this mapping that no accessor asked for.
+  void finish() const;
+
+ private:
+  friend class CaseFile;
+  struct Entry;  // a value with its key path and line; defined in case_file.cpp
+
+  CaseNode(std::shared_ptr<detail::CaseState> state, std::size_t index, std::string path, int line,
+           detail::CaseRecord* record);
+  static CaseNode open(const std::shared_ptr<detail::CaseState>& state, const Entry& entry,
+                       detail::CaseRecord& record);
+
+  Entry find(std::string_view key) const;
+  Entry lookup(std::string_view key);  // find + record the key as known
+  std::vector<Entry> elements(const Entry& list, std::string_view expected) const;
+  std::vector<CaseNode> items(const Entry& list, std::string_view key);
+  double to_number(const Entry& e, Range range, std::string_view unit, bool integer) const;
+  std::string to_string(const Entry& e) const;
+  std::string where(const Entry& e) const;
+  [[noreturn]] void missing(std::string_view key, std::string_view expected) const;
+  [[noreturn]] void mismatch(const Entry& e, std::string_view expected) const;
+
+  std::shared_ptr<detail::CaseState> state_;
+  std::size_t index_;  // this mapping in the state's node table
+  std::string path_;
+  int line_;  // 1-based line of this mapping's key (0 if unknown)
+  detail::CaseRecord* record_;  // this mapping's part of the resolved document
+};
+
+// A loaded case document with its command-line overrides applied.
+class CaseFile {
+ public:
+  // `overrides` are "a.b.c=value" texts from --set; the value is parsed as YAML.
+  static CaseFile load(const std::filesystem::path& file,
+                       const std::vector<std::string>& overrides = {});
+
+  CaseNode root();
+  // YAML of every value read so far (defaults included), in read order.
+  std::string resolved_yaml() const;
+  const std::filesystem::path& path() const;
+
+ private:
+  explicit CaseFile(std::shared_ptr<detail::CaseState> state) : state_(std::move(state)) {}
+  std::shared_ptr<detail::CaseState> state_;
+};
+
+}  // namespace arlequin

@@ -1,0 +1,359 @@
+#include "continuum/continuum_solver.hpp"
+
+#include <petscksp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "common/error.hpp"
+#include "continuum/petsc_session.hpp"
+
+namespace arlequin::continuum {
+
+namespace {
+
+// Dunavant degree-4 rule on a triangle (Dunavant, IJNME 21 (1985)), barycentric (a, b, b)
+// permutations; weights sum to 1. Degree 4 integrates P2 traces exactly and natural-neighbour
+// traces well.
+constexpr double kTriA[2] = {0.445948490915965, 0.091576213509771};
+constexpr double kTriW[2] = {0.223381589678011, 0.109951743655322};
+
+void check(PetscErrorCode code, const char* what) { petsc_check(static_cast<int>(code), what); }
+
+}  // namespace
+
+ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings) : mesh_(Mesh::load(settings.mesh)) {
+  PetscSession::ensure(settings.petsc_options);
+  if (settings.materials.empty()) throw InputError("continuum: no material given");
+  tet_material_.assign(mesh_.num_tets(), -1);
+  for (const auto& rm : settings.materials) {
+    const int index = static_cast<int>(materials_.size());
+    materials_.push_back(rm.material);
+    if (rm.region.empty()) {
+      std::fill(tet_material_.begin(), tet_material_.end(), index);
+      continue;
+    }
+    const PhysicalGroup& g = mesh_.group(rm.region);
+    if (g.dim != 3) throw InputError("material region '" + rm.region + "' is not a volume group");
+    for (int e : g.tets) tet_material_[e] = index;
+  }
+  if (std::find(tet_material_.begin(), tet_material_.end(), -1) != tet_material_.end())
+    throw InputError("continuum: some tetrahedra lie in no region with a material");
+  const size_t ndof = 3 * static_cast<size_t>(mesh_.num_nodes());
+  u_.assign(ndof, 0.0);
+  v_.assign(ndof, 0.0);
+  f_.assign(ndof, 0.0);
+  is_fixed_.assign(ndof, 0);
+}
+
+ContinuumSolver::~ContinuumSolver() = default;
+
+void ContinuumSolver::finish_setup() { set_weight([](const Vec3&) { return 1.0; }); }
+
+void ContinuumSolver::set_weight(ScalarFunction alpha) {
+  alpha_ = std::move(alpha);
+  point_weight_.resize(points_.x.size());
+  for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
+  mass_ = weighted_lumped_mass(alpha_);
+}
+
+void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> components, VectorFunction g) {
+  for (int n : mesh_.group(group).nodes)
+    for (int c = 0; c < 3; ++c) {
+      if (!components[c]) continue;
+      const int dof = 3 * n + c;
+      auto it = std::find_if(fixed_.begin(), fixed_.end(), [&](const Fixed& f) { return f.dof == dof; });
+      if (it != fixed_.end())
+        it->g = g;  // the later BC on a shared node wins
+      else
+        fixed_.push_back({dof, g});
+      is_fixed_[dof] = 1;
+      u_[dof] = g(nodes()[n], t_)[c];
+    }
+}
+
+double ContinuumSolver::prescribed(const Fixed& f, double t) const {
+  return f.g(nodes()[f.dof / 3], t)[f.dof % 3];
+}
+
+void ContinuumSolver::add_traction(const std::string& group, VectorFunction traction) {
+  const PhysicalGroup& g = mesh_.group(group);
+  if (g.dim != 2) throw InputError("traction group '" + group + "' is not a surface group");
+  Traction tr;
+  tr.fn = std::move(traction);
+  for (const auto& tri : g.triangles) {
+    const Vec3 &a = nodes()[tri[0]], &b = nodes()[tri[1]], &c = nodes()[tri[2]];
+    const double area = 0.5 * norm(cross(b - a, c - a));
+    for (int r = 0; r < 2; ++r) {
+      const double p = kTriA[r], s = 1.0 - 2.0 * p;
+      const std::array<std::array<double, 3>, 3> bary{{{s, p, p}, {p, s, p}, {p, p, s}}};
+      for (const auto& l : bary) {
+        tr.x.push_back(l[0] * a + l[1] * b + l[2] * c);
+        tr.w.push_back(kTriW[r] * area);
+      }
+    }
+  }
+  tr.N = interpolation(tr.x);
+  tractions_.push_back(std::move(tr));
+}
+
+Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
+  Voigt e = Voigt::Zero();
+  for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+    const Vec3& g = points_.grad[k];
+    const double* uj = &u[3 * static_cast<size_t>(points_.node[k])];
+    e[0] += g.x * uj[0];
+    e[1] += g.y * uj[1];
+    e[2] += g.z * uj[2];
+    e[3] += g.z * uj[1] + g.y * uj[2];
+    e[4] += g.z * uj[0] + g.x * uj[2];
+    e[5] += g.y * uj[0] + g.x * uj[1];
+  }
+  return e;
+}
+
+void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
+  f_int.assign(u.size(), 0.0);
+  const int nq = static_cast<int>(points_.x.size());
+  for (int q = 0; q < nq; ++q) {
+    const Voigt s = point_weight_[q] * (materials_[points_.material[q]].C * strain_at(q, u));
+    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+      const Vec3& g = points_.grad[k];
+      double* fj = &f_int[3 * static_cast<size_t>(points_.node[k])];
+      fj[0] += g.x * s[0] + g.z * s[4] + g.y * s[5];
+      fj[1] += g.y * s[1] + g.z * s[3] + g.x * s[5];
+      fj[2] += g.z * s[2] + g.y * s[3] + g.x * s[4];
+    }
+  }
+}
+
+void ContinuumSolver::add_external_force(Field& f) const {
+  for (const Traction& tr : tractions_) {
+    for (int p = 0; p < tr.N.rows(); ++p) {
+      const Vec3 t = tr.w[p] * tr.fn(tr.x[p], t_);
+      for (InterpolationOperator::InnerIterator it(tr.N, p); it; ++it) {
+        double* fj = &f[3 * static_cast<size_t>(it.col())];
+        fj[0] += it.value() * t.x;
+        fj[1] += it.value() * t.y;
+        fj[2] += it.value() * t.z;
+      }
+    }
+  }
+}
+
+void ContinuumSolver::compute_forces() {
+  internal_force(u_, f_);
+  for (double& v : f_) v = -v;
+  add_external_force(f_);
+}
+
+void ContinuumSolver::kick(double dt) {
+  for (size_t d = 0; d < v_.size(); ++d)
+    if (!is_fixed_[d]) v_[d] += dt * f_[d] / mass_[d / 3];
+}
+
+void ContinuumSolver::drift(double dt) {
+  t_ += dt;
+  for (size_t d = 0; d < u_.size(); ++d)
+    if (!is_fixed_[d]) u_[d] += dt * v_[d];
+  for (const Fixed& f : fixed_) {
+    const double g = prescribed(f, t_);
+    v_[f.dof] = (g - u_[f.dof]) / dt;
+    u_[f.dof] = g;
+  }
+}
+
+void ContinuumSolver::step(double dt) {
+  kick(0.5 * dt);
+  drift(dt);
+  compute_forces();
+  kick(0.5 * dt);
+  double sum = 0;
+  for (double v : v_) sum += v;
+  if (!std::isfinite(sum)) throw RunError("continuum: non-finite state at t = " + std::to_string(t_));
+}
+
+// Largest eigenvalue of the symmetric M^-1/2 K M^-1/2 by power iteration with the Rayleigh
+// quotient, which approaches omega_max^2 from below; the start vector is random so it has a
+// component along the top modes. dt_c = 2 / omega_max (central difference, e.g. Belytschko,
+// Liu & Moran, Nonlinear Finite Elements, section 6.3).
+double ContinuumSolver::critical_time_step() const {
+  for (double m : mass_)
+    if (!(m > 0)) throw RunError("continuum: a lumped mass is not positive (weight without floor?)");
+  const size_t n = u_.size();
+  Field x(n), y, scaled(n);
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (double& xi : x) xi = uni(rng);
+  double lambda = 0.0;
+  for (int it = 0; it < 1000; ++it) {
+    double nx = 0;
+    for (double xi : x) nx += xi * xi;
+    nx = std::sqrt(nx);
+    for (size_t d = 0; d < n; ++d) scaled[d] = x[d] / nx / std::sqrt(mass_[d / 3]);
+    internal_force(scaled, y);
+    double rq = 0;
+    for (size_t d = 0; d < n; ++d) {
+      y[d] /= std::sqrt(mass_[d / 3]);
+      rq += y[d] * x[d] / nx;
+    }
+    const bool converged = it > 50 && std::abs(rq - lambda) <= 1e-7 * rq;
+    lambda = rq;
+    if (converged) break;
+    x.swap(y);
+  }
+  if (!(lambda > 0)) throw RunError("continuum: could not estimate the highest frequency");
+  return 2.0 / std::sqrt(lambda);
+}
+
+void ContinuumSolver::solve_static(const std::string& petsc_options) {
+  const PetscInt nn = mesh_.num_nodes(), n = 3 * nn;
+  // Block sparsity: nodes sharing an integration point are coupled.
+  std::vector<std::vector<int>> adj(nn);
+  const int nq = static_cast<int>(points_.x.size());
+  for (int q = 0; q < nq; ++q)
+    for (int a = points_.offset[q]; a < points_.offset[q + 1]; ++a)
+      for (int b = points_.offset[q]; b < points_.offset[q + 1]; ++b) adj[points_.node[a]].push_back(points_.node[b]);
+  std::vector<PetscInt> nnz(n);
+  for (int i = 0; i < nn; ++i) {
+    auto& a = adj[i];
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    for (int c = 0; c < 3; ++c) nnz[3 * i + c] = 3 * static_cast<PetscInt>(a.size());
+    std::vector<int>().swap(a);
+  }
+
+  Mat K;
+  check(MatCreate(PETSC_COMM_SELF, &K), "MatCreate");
+  check(MatSetSizes(K, n, n, n, n), "MatSetSizes");
+  check(MatSetType(K, MATSEQAIJ), "MatSetType");
+  check(MatSetBlockSize(K, 3), "MatSetBlockSize");
+  check(MatSeqAIJSetPreallocation(K, 0, nnz.data()), "MatSeqAIJSetPreallocation");
+  std::vector<PetscInt> idx;
+  std::vector<PetscScalar> ke;
+  for (int q = 0; q < nq; ++q) {
+    const int b0 = points_.offset[q], m = points_.offset[q + 1] - b0;
+    const Stiffness C = point_weight_[q] * materials_[points_.material[q]].C;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, 3 * m);
+    idx.resize(m);
+    for (int a = 0; a < m; ++a) {
+      const Vec3& g = points_.grad[b0 + a];
+      idx[a] = points_.node[b0 + a];
+      B(0, 3 * a) = g.x;
+      B(1, 3 * a + 1) = g.y;
+      B(2, 3 * a + 2) = g.z;
+      B(3, 3 * a + 1) = g.z, B(3, 3 * a + 2) = g.y;
+      B(4, 3 * a) = g.z, B(4, 3 * a + 2) = g.x;
+      B(5, 3 * a) = g.y, B(5, 3 * a + 1) = g.x;
+    }
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Ke = B.transpose() * C * B;
+    check(MatSetValuesBlocked(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES), "MatSetValuesBlocked");
+  }
+  check(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  check(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+
+  Field f_ext(u_.size(), 0.0);
+  add_external_force(f_ext);
+  Vec b, x, coords;
+  check(VecCreateSeq(PETSC_COMM_SELF, n, &b), "VecCreateSeq");
+  check(VecDuplicate(b, &x), "VecDuplicate");
+  PetscScalar* pb;
+  PetscScalar* px;
+  check(VecGetArray(b, &pb), "VecGetArray");
+  check(VecGetArray(x, &px), "VecGetArray");
+  std::vector<PetscInt> rows;
+  for (PetscInt d = 0; d < n; ++d) {
+    pb[d] = f_ext[d];
+    px[d] = 0.0;
+  }
+  for (const Fixed& f : fixed_) {
+    px[f.dof] = prescribed(f, t_);
+    rows.push_back(f.dof);
+  }
+  check(VecRestoreArray(b, &pb), "VecRestoreArray");
+  check(VecRestoreArray(x, &px), "VecRestoreArray");
+  // Eliminate fixed components symmetrically (keeps CG applicable); the unit diagonal is
+  // scaled to the matrix so the conditioning does not suffer.
+  Vec diag;
+  check(VecDuplicate(b, &diag), "VecDuplicate");
+  check(MatGetDiagonal(K, diag), "MatGetDiagonal");
+  PetscReal dsum;
+  check(VecSum(diag, &dsum), "VecSum");
+  check(VecDestroy(&diag), "VecDestroy");
+  check(MatZeroRowsColumns(K, static_cast<PetscInt>(rows.size()), rows.data(), dsum / n, x, b), "MatZeroRowsColumns");
+
+  // Rigid-body near-null space helps algebraic multigrid on elasticity.
+  check(VecCreateSeq(PETSC_COMM_SELF, n, &coords), "VecCreateSeq");
+  check(VecSetBlockSize(coords, 3), "VecSetBlockSize");
+  PetscScalar* pc;
+  check(VecGetArray(coords, &pc), "VecGetArray");
+  for (PetscInt i = 0; i < nn; ++i) {
+    pc[3 * i] = nodes()[i].x;
+    pc[3 * i + 1] = nodes()[i].y;
+    pc[3 * i + 2] = nodes()[i].z;
+  }
+  check(VecRestoreArray(coords, &pc), "VecRestoreArray");
+  MatNullSpace rigid;
+  check(MatNullSpaceCreateRigidBody(coords, &rigid), "MatNullSpaceCreateRigidBody");
+  check(MatSetNearNullSpace(K, rigid), "MatSetNearNullSpace");
+
+  // The option string lives in its own options database, pushed while the solver is set up
+  // and run, so one solve's options never leak into another's.
+  PetscOptions db;
+  check(PetscOptionsCreate(&db), "PetscOptionsCreate");
+  check(PetscOptionsInsertString(db, ("-ksp_type cg -pc_type gamg -ksp_rtol 1e-12 " + petsc_options).c_str()),
+        "PETSc options");
+  check(PetscOptionsPush(db), "PetscOptionsPush");
+  KSP ksp;
+  KSPConvergedReason reason;
+  check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
+  check(KSPSetOperators(ksp, K, K), "KSPSetOperators");
+  check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+  check(KSPSolve(ksp, b, x), "KSPSolve");
+  check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+  check(PetscOptionsPop(), "PetscOptionsPop");
+  check(PetscOptionsDestroy(&db), "PetscOptionsDestroy");
+
+  const PetscScalar* sol;
+  check(VecGetArrayRead(x, &sol), "VecGetArrayRead");
+  std::copy(sol, sol + n, u_.begin());
+  check(VecRestoreArrayRead(x, &sol), "VecRestoreArrayRead");
+  KSPDestroy(&ksp);
+  MatNullSpaceDestroy(&rigid);
+  VecDestroy(&coords);
+  VecDestroy(&x);
+  VecDestroy(&b);
+  MatDestroy(&K);
+  if (reason < 0) throw RunError("continuum: static solve did not converge (KSPConvergedReason " + std::to_string(reason) + ")");
+  compute_forces();
+}
+
+double ContinuumSolver::strain_energy() const {
+  double e = 0;
+  for (int q = 0; q < static_cast<int>(points_.x.size()); ++q) {
+    const Voigt eps = strain_at(q, u_);
+    e += 0.5 * point_weight_[q] * eps.dot(materials_[points_.material[q]].C * eps);
+  }
+  return e;
+}
+
+double ContinuumSolver::kinetic_energy() const {
+  double e = 0;
+  for (size_t d = 0; d < v_.size(); ++d) e += 0.5 * mass_[d / 3] * v_[d] * v_[d];
+  return e;
+}
+
+std::vector<Voigt> ContinuumSolver::point_strain() const {
+  std::vector<Voigt> out(points_.x.size());
+  for (size_t q = 0; q < out.size(); ++q) out[q] = strain_at(static_cast<int>(q), u_);
+  return out;
+}
+
+std::vector<Voigt> ContinuumSolver::point_stress() const {
+  std::vector<Voigt> out = point_strain();
+  for (size_t q = 0; q < out.size(); ++q) out[q] = materials_[points_.material[q]].C * out[q];
+  return out;
+}
+
+}  // namespace arlequin::continuum

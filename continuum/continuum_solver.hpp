@@ -1,0 +1,146 @@
+// ContinuumSolver: one linear-elastic continuum on a gmsh mesh, discretised by a named method
+// (see registry.hpp). Everything the coupling and the application use is here; a method only
+// supplies its integration points, its lumped mass and its interpolation.
+//
+// Contract
+//  - Unknowns: one displacement vector per node of `nodes()`; fields (`Field`) hold 3 values per
+//    node, node-major (x0, y0, z0, x1, ...).
+//  - Weight alpha(x) (Arlequin, default 1) multiplies every volume integrand: the lumped mass,
+//    the internal force, the stiffness and the strain energy. The caller applies any mass floor.
+//  - Strain at integration point q is B_q u (constant per point); forces and energies are sums
+//    over points: f_int = sum_q w_q B_q^T C_q B_q u, E_strain = 1/2 sum_q w_q eps_q.C_q eps_q,
+//    with w_q = alpha(x_q) |cell_q|.
+//  - `interpolation(points)` returns the sparse operator N (rows: points, columns: nodes) with
+//    u(point_p) = sum_I N(p, I) u_I per component; points outside the body are an InputError.
+//  - Essential BCs act on named physical groups and fix chosen components to g(X, t); loads are
+//    tractions on named boundary groups, integrated with the method's own shape functions.
+//  - Explicit central difference = velocity Verlet: kick(dt/2), drift(dt), compute_forces(),
+//    kick(dt/2) (`step`). The coupled step of DESIGN section 2 calls the three parts itself.
+//    Stable for dt < critical_time_step() = 2 / omega_max of M^-1 K (power iteration).
+//  - `solve_static` assembles K into a PETSc Mat and solves K u = f with KSP; the PETSc option
+//    string (e.g. "-ksp_type cg -pc_type gamg") overrides the defaults "cg + gamg, rtol 1e-12".
+//  - Mesh and input problems are InputError; failed solves and non-finite states are RunError.
+#pragma once
+#include <Eigen/Sparse>
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/vec3.hpp"
+#include "continuum/material.hpp"
+#include "continuum/mesh.hpp"
+
+namespace arlequin::continuum {
+
+using Field = std::vector<double>;
+using InterpolationOperator = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using ScalarFunction = std::function<double(const Vec3& x)>;
+using VectorFunction = std::function<Vec3(const Vec3& x, double t)>;
+
+struct RegionMaterial {
+  std::string region;  // name of a 3D physical group; empty = the whole mesh
+  Material material;
+};
+
+struct ContinuumSettings {
+  MeshSource mesh;
+  std::vector<RegionMaterial> materials;
+  std::string petsc_options;              // given to PetscSession on the first continuum built
+  std::string shape_functions = "sibson";  // nem only: "sibson" or "laplace"
+};
+
+class ContinuumSolver {
+ public:
+  virtual ~ContinuumSolver();
+  ContinuumSolver(const ContinuumSolver&) = delete;
+  ContinuumSolver& operator=(const ContinuumSolver&) = delete;
+
+  const Mesh& mesh() const { return mesh_; }
+  const std::vector<Vec3>& nodes() const { return mesh_.nodes(); }
+  int num_nodes() const { return mesh_.num_nodes(); }
+
+  // Arlequin weight; recomputes the lumped mass and the point weights.
+  void set_weight(ScalarFunction alpha);
+  const std::vector<double>& lumped_mass() const { return mass_; }  // per node, weighted
+
+  virtual InterpolationOperator interpolation(const std::vector<Vec3>& points) const = 0;
+
+  // Fixes `components` of every node of `group` to g(X, t) (applied now and at every drift).
+  void fix(const std::string& group, std::array<bool, 3> components, VectorFunction g);
+  // Traction (force per area, function of position and time) on a 2D physical group.
+  void add_traction(const std::string& group, VectorFunction traction);
+
+  Field& displacement() { return u_; }
+  Field& velocity() { return v_; }
+  const Field& displacement() const { return u_; }
+  const Field& velocity() const { return v_; }
+  const Field& force() const { return f_; }  // f_ext(t) - f_int(u) from the last compute_forces
+  double time() const { return t_; }
+
+  void compute_forces();
+  void kick(double dt);   // v += dt M^-1 f on free components
+  void drift(double dt);  // u += dt v on free components; t += dt; fixed ones follow g
+  void step(double dt);
+  double critical_time_step() const;
+
+  // Static equilibrium at the current time; leaves u solved, v untouched, forces updated.
+  void solve_static(const std::string& petsc_options = "");
+
+  void internal_force(const Field& u, Field& f_int) const;
+  double strain_energy() const;
+  double kinetic_energy() const;
+
+  // Integration points, for output and checks: positions and strain / stress (Voigt).
+  const std::vector<Vec3>& point_positions() const { return points_.x; }
+  std::vector<Voigt> point_strain() const;
+  std::vector<Voigt> point_stress() const;
+
+ protected:
+  explicit ContinuumSolver(const ContinuumSettings& settings);
+
+  // Integration points in compressed rows: point q couples nodes node[offset[q] .. offset[q+1])
+  // with (smoothed) shape-function gradients grad[...] and has measure volume[q].
+  struct Points {
+    std::vector<Vec3> x;
+    std::vector<double> volume;
+    std::vector<int> material;
+    std::vector<int> offset{0};
+    std::vector<int> node;
+    std::vector<Vec3> grad;
+  };
+  // Derived constructors fill points_ and then call finish_setup().
+  void finish_setup();
+  virtual std::vector<double> weighted_lumped_mass(const ScalarFunction& alpha) const = 0;
+
+  Mesh mesh_;
+  std::vector<Material> materials_;
+  std::vector<int> tet_material_;  // per tetrahedron, index into materials_
+  Points points_;
+
+ private:
+  struct Traction {
+    InterpolationOperator N;  // at the quadrature points
+    std::vector<Vec3> x;
+    std::vector<double> w;
+    VectorFunction fn;
+  };
+  struct Fixed {
+    int dof;
+    VectorFunction g;
+  };
+  Voigt strain_at(int q, const Field& u) const;
+  void add_external_force(Field& f) const;
+  double prescribed(const Fixed& f, double t) const;
+
+  ScalarFunction alpha_;
+  std::vector<double> point_weight_;  // alpha(x_q) volume_q
+  std::vector<double> mass_;
+  std::vector<Fixed> fixed_;
+  std::vector<char> is_fixed_;  // per dof
+  std::vector<Traction> tractions_;
+  Field u_, v_, f_;
+  double t_ = 0.0;
+};
+
+}  // namespace arlequin::continuum

@@ -1,0 +1,219 @@
+#include "continuum/mesh.hpp"
+
+#include <gmsh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <unordered_map>
+
+#include "common/error.hpp"
+
+namespace arlequin::continuum {
+
+namespace {
+
+double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return dot(b - a, cross(c - a, d - a)) / 6.0;
+}
+
+// gmsh keeps global state: one mesh at a time, with its own initialize/finalize around it.
+std::mutex g_gmsh_mutex;
+
+struct GmshScope {
+  GmshScope() {
+    gmsh::initialize();
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.NumThreads", 1);  // reproducible meshes
+  }
+  ~GmshScope() { gmsh::finalize(); }
+};
+
+}  // namespace
+
+Mesh Mesh::load(const MeshSource& source) {
+  namespace fs = std::filesystem;
+  if (!fs::exists(source.path)) throw InputError("mesh file not found: " + source.path);
+  const std::string ext = fs::path(source.path).extension().string();
+  if (ext != ".geo" && ext != ".msh") throw InputError("mesh file must be .geo or .msh: " + source.path);
+  if (source.order != 1 && source.order != 2) throw InputError("mesh order must be 1 or 2, got " + std::to_string(source.order));
+
+  std::lock_guard<std::mutex> lock(g_gmsh_mutex);
+  GmshScope scope;
+  try {
+    gmsh::open(source.path);
+    if (ext == ".geo") {
+      if (source.size > 0.0) {
+        gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
+        gmsh::option::setNumber("Mesh.MeshSizeMin", source.size);
+        gmsh::option::setNumber("Mesh.MeshSizeMax", source.size);
+      }
+      // Straight-sided P2 (edge nodes at midpoints): the solvers use affine geometry.
+      gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);
+      gmsh::model::mesh::generate(3);
+      if (source.order == 2) gmsh::model::mesh::setOrder(2);
+    }
+  } catch (const std::exception& e) {
+    throw InputError("gmsh could not mesh/read " + source.path + ": " + e.what());
+  }
+
+  std::vector<std::size_t> node_tags;
+  std::vector<double> coords, param;
+  gmsh::model::mesh::getNodes(node_tags, coords, param);
+  std::unordered_map<std::size_t, Vec3> tag_xyz;
+  for (size_t i = 0; i < node_tags.size(); ++i) tag_xyz[node_tags[i]] = {coords[3 * i], coords[3 * i + 1], coords[3 * i + 2]};
+
+  std::vector<int> types;
+  std::vector<std::vector<std::size_t>> elem_tags, elem_nodes;
+  gmsh::model::mesh::getElements(types, elem_tags, elem_nodes, 3);
+  int order = 0, npe = 0;
+  std::vector<std::size_t> tet_tags, tet_node_tags;
+  for (size_t k = 0; k < types.size(); ++k) {
+    if (types[k] != 4 && types[k] != 11)
+      throw InputError(source.path + ": only tetrahedra are supported (gmsh element type " + std::to_string(types[k]) + ")");
+    order = types[k] == 4 ? 1 : 2;
+    npe = types[k] == 4 ? 4 : 10;
+    tet_tags = elem_tags[k];
+    tet_node_tags = elem_nodes[k];
+  }
+  if (types.size() > 1) throw InputError(source.path + ": mixed linear and quadratic tetrahedra");
+  if (tet_tags.empty()) throw InputError(source.path + ": the mesh has no tetrahedra (is there a volume?)");
+
+  // Compact numbering of the nodes used by tetrahedra.
+  std::unordered_map<std::size_t, int> node_index;
+  std::vector<Vec3> nodes;
+  std::vector<int> tets;
+  tets.reserve(tet_node_tags.size());
+  for (std::size_t t : tet_node_tags) {
+    auto [it, fresh] = node_index.try_emplace(t, static_cast<int>(nodes.size()));
+    if (fresh) nodes.push_back(tag_xyz.at(t));
+    tets.push_back(it->second);
+  }
+  std::unordered_map<std::size_t, int> tet_index;
+  for (size_t e = 0; e < tet_tags.size(); ++e) tet_index[tet_tags[e]] = static_cast<int>(e);
+
+  std::vector<PhysicalGroup> groups;
+  gmsh::vectorpair dim_tags;
+  gmsh::model::getPhysicalGroups(dim_tags);
+  for (auto [dim, tag] : dim_tags) {
+    if (dim != 2 && dim != 3) continue;
+    PhysicalGroup g;
+    g.dim = dim;
+    gmsh::model::getPhysicalName(dim, tag, g.name);
+    if (g.name.empty()) g.name = std::to_string(tag);
+    std::vector<std::size_t> gtags;
+    std::vector<double> gcoords;
+    gmsh::model::mesh::getNodesForPhysicalGroup(dim, tag, gtags, gcoords);
+    for (std::size_t t : gtags) {
+      auto it = node_index.find(t);
+      if (it != node_index.end()) g.nodes.push_back(it->second);
+    }
+    std::sort(g.nodes.begin(), g.nodes.end());
+    g.nodes.erase(std::unique(g.nodes.begin(), g.nodes.end()), g.nodes.end());
+    std::vector<int> entities;
+    gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
+    for (int ent : entities) {
+      std::vector<int> etypes;
+      std::vector<std::vector<std::size_t>> etags, enodes;
+      gmsh::model::mesh::getElements(etypes, etags, enodes, dim, ent);
+      for (size_t k = 0; k < etypes.size(); ++k) {
+        if (dim == 3) {
+          for (std::size_t t : etags[k]) g.tets.push_back(tet_index.at(t));
+        } else {
+          const size_t per = enodes[k].size() / std::max<size_t>(etags[k].size(), 1);
+          for (size_t f = 0; f < etags[k].size(); ++f)
+            g.triangles.push_back({node_index.at(enodes[k][per * f]), node_index.at(enodes[k][per * f + 1]),
+                                   node_index.at(enodes[k][per * f + 2])});
+        }
+      }
+    }
+    groups.push_back(std::move(g));
+  }
+
+  // gmsh's P2 edge order differs from kTetEdges: place each edge node by its position.
+  if (order == 2) {
+    const int ntet = static_cast<int>(tets.size()) / npe;
+    for (int e = 0; e < ntet; ++e) {
+      int* t = tets.data() + static_cast<size_t>(e) * npe;
+      std::array<int, 6> edge{-1, -1, -1, -1, -1, -1};
+      const double h = norm(nodes[t[1]] - nodes[t[0]]) + norm(nodes[t[2]] - nodes[t[0]]) + norm(nodes[t[3]] - nodes[t[0]]);
+      for (int m = 4; m < 10; ++m)
+        for (int k = 0; k < 6; ++k) {
+          const Vec3 mid = 0.5 * (nodes[t[kTetEdges[k][0]]] + nodes[t[kTetEdges[k][1]]]);
+          if (norm(nodes[t[m]] - mid) <= 1e-9 * h) edge[k] = t[m];
+        }
+      if (std::find(edge.begin(), edge.end(), -1) != edge.end())
+        throw InputError(source.path + ": quadratic tetrahedron " + std::to_string(e) +
+                         " has an edge node away from its edge midpoint (curved elements are not supported)");
+      std::copy(edge.begin(), edge.end(), t + 4);
+    }
+  }
+  return Mesh(order, std::move(nodes), std::move(tets), std::move(groups));
+}
+
+Mesh::Mesh(int order, std::vector<Vec3> nodes, std::vector<int> tets, std::vector<PhysicalGroup> groups)
+    : order_(order), nodes_(std::move(nodes)), tets_(std::move(tets)), groups_(std::move(groups)) {
+  if (num_tets() == 0) throw InputError("mesh has no tetrahedra");
+  double lmax = 0.0;
+  for (int e = 0; e < num_tets(); ++e) lmax = std::max(lmax, norm(nodes_[tet(e)[1]] - nodes_[tet(e)[0]]));
+  for (int e = 0; e < num_tets(); ++e) {
+    const double v = tet_volume(e);
+    if (v <= 1e-12 * lmax * lmax * lmax) {
+      std::ostringstream msg;
+      const Vec3& c = nodes_[tet(e)[0]];
+      msg << (v < 0 ? "inverted" : "flat") << " tetrahedron " << e << " (volume " << v << ") at (" << c.x << ", "
+          << c.y << ", " << c.z << ")";
+      throw InputError(msg.str());
+    }
+  }
+  for (const auto& g : groups_) {
+    if (g.nodes.empty() || (g.dim == 3 && g.tets.empty()) || (g.dim == 2 && g.triangles.empty()))
+      throw InputError("physical group '" + g.name + "' is empty");
+  }
+}
+
+double Mesh::tet_volume(int e) const {
+  const int* t = tet(e);
+  return signed_volume(nodes_[t[0]], nodes_[t[1]], nodes_[t[2]], nodes_[t[3]]);
+}
+
+double Mesh::volume() const {
+  double v = 0.0;
+  for (int e = 0; e < num_tets(); ++e) v += tet_volume(e);
+  return v;
+}
+
+bool Mesh::has_group(const std::string& name) const {
+  return std::any_of(groups_.begin(), groups_.end(), [&](const PhysicalGroup& g) { return g.name == name; });
+}
+
+const PhysicalGroup& Mesh::group(const std::string& name) const {
+  for (const auto& g : groups_)
+    if (g.name == name) return g;
+  std::string known;
+  for (const auto& g : groups_) known += (known.empty() ? "" : ", ") + g.name;
+  throw InputError("mesh has no physical group '" + name + "' (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+std::vector<std::array<int, 3>> Mesh::boundary_triangles() const {
+  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // outward for V > 0
+  std::map<std::array<int, 3>, std::pair<std::array<int, 3>, int>> count;
+  for (int e = 0; e < num_tets(); ++e)
+    for (const auto& f : kFaces) {
+      std::array<int, 3> tri{tet(e)[f[0]], tet(e)[f[1]], tet(e)[f[2]]};
+      std::array<int, 3> key = tri;
+      std::sort(key.begin(), key.end());
+      auto& entry = count[key];
+      entry.first = tri;
+      ++entry.second;
+    }
+  std::vector<std::array<int, 3>> out;
+  for (const auto& [key, entry] : count)
+    if (entry.second == 1) out.push_back(entry.first);
+  return out;
+}
+
+}  // namespace arlequin::continuum

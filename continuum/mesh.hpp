@@ -1,0 +1,64 @@
+// Mesh: a tetrahedral mesh with named physical groups, read or generated through the gmsh C++ API.
+// Contract:
+//  - `Mesh::load` meshes a .geo file in-process (element size `size`, order 1 or 2) or reads a
+//    ready .msh (its own order). Only tetrahedra are kept; nodes not used by a tetrahedron drop.
+//  - Tetrahedra are stored with positive volume, vertices first; quadratic tetrahedra are
+//    renumbered to the fixed edge order of `kTetEdges` (gmsh's own order is not assumed: every
+//    edge node is matched to the midpoint of its two vertices, which also rejects curved P2).
+//  - Problems are InputError: unreadable file, no tetrahedra, inverted or flat tetrahedron,
+//    empty physical group, unknown group name (the message lists the known ones).
+#pragma once
+#include <array>
+#include <string>
+#include <vector>
+
+#include "common/vec3.hpp"
+
+namespace arlequin::continuum {
+
+struct MeshSource {
+  std::string path;   // .geo (meshed here) or .msh
+  double size = 0.0;  // target element size for .geo; 0 keeps the sizes written in the file
+  int order = 1;      // 1 or 2, for .geo
+};
+
+// Edge k of a tetrahedron joins vertices kTetEdges[k]; node 4+k of a P2 tetrahedron sits on it.
+inline constexpr std::array<std::array<int, 2>, 6> kTetEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+
+struct PhysicalGroup {
+  std::string name;
+  int dim = 0;                                 // 2: boundary part, 3: region
+  std::vector<int> nodes;                      // sorted, all nodes of its entities (P2 included)
+  std::vector<std::array<int, 3>> triangles;   // dim 2: vertex triples
+  std::vector<int> tets;                       // dim 3: tetrahedron indices
+};
+
+class Mesh {
+ public:
+  static Mesh load(const MeshSource& source);
+  // Builds from arrays (tests, generated meshes); checks orientation like `load`.
+  Mesh(int order, std::vector<Vec3> nodes, std::vector<int> tets, std::vector<PhysicalGroup> groups);
+
+  int order() const { return order_; }
+  int nodes_per_tet() const { return order_ == 1 ? 4 : 10; }
+  int num_nodes() const { return static_cast<int>(nodes_.size()); }
+  int num_tets() const { return static_cast<int>(tets_.size()) / nodes_per_tet(); }
+  const std::vector<Vec3>& nodes() const { return nodes_; }
+  const int* tet(int e) const { return tets_.data() + static_cast<size_t>(e) * nodes_per_tet(); }
+  double tet_volume(int e) const;
+  double volume() const;
+
+  const std::vector<PhysicalGroup>& groups() const { return groups_; }
+  bool has_group(const std::string& name) const;
+  const PhysicalGroup& group(const std::string& name) const;  // InputError if unknown
+  // Triangles (vertex triples) on the outer boundary: faces owned by one tetrahedron only.
+  std::vector<std::array<int, 3>> boundary_triangles() const;
+
+ private:
+  int order_;
+  std::vector<Vec3> nodes_;
+  std::vector<int> tets_;
+  std::vector<PhysicalGroup> groups_;
+};
+
+}  // namespace arlequin::continuum

@@ -1,0 +1,144 @@
+#include "dem/beam_bond.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "common/case_file.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+// Rotation vector turning unit vector a onto unit vector b (angle from atan2: exact for any
+// angle, no loss near 0 or pi/2).
+inline Vec3 rotation_between(const Vec3& a, const Vec3& b) {
+  const Vec3 axis = cross(a, b);
+  const double s = norm(axis);
+  if (s < 1e-300) return {};
+  return axis * (std::atan2(s, dot(a, b)) / s);
+}
+
+// A unit vector perpendicular to d, chosen from the coordinate axis least aligned with d.
+inline Vec3 perpendicular_to(const Vec3& d) {
+  const Vec3 ax{std::abs(d.x), std::abs(d.y), std::abs(d.z)};
+  const Vec3 e = (ax.x <= ax.y && ax.x <= ax.z) ? Vec3{1, 0, 0}
+                 : (ax.y <= ax.z)               ? Vec3{0, 1, 0}
+                                                : Vec3{0, 0, 1};
+  return normalized(cross(d, e));
+}
+
+}  // namespace
+
+std::unique_ptr<BondSet> BeamBondSet::make(CaseNode& section) {
+  Parameters prm;
+  prm.young = section.number("E_mu", Range::positive(), "Pa");
+  prm.poisson = section.number_or("nu_mu", 0.3, Range::open_between(-1.0, 0.5), "1");
+  prm.radius_ratio = section.number("r_mu", Range::open_between(0.0, 2.0), "1");
+  return std::make_unique<BeamBondSet>(prm);
+}
+
+void BeamBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
+  const Quat identity{};
+  if (!(p.orientation[i].w == identity.w && p.orientation[i].v == identity.v &&
+        p.orientation[j].w == identity.w && p.orientation[j].v == identity.v))
+    throw std::logic_error("BeamBondSet::add: DEs must have their reference orientation");
+  const Vec3 d = p.position[j] - p.position[i];
+  const double L0 = norm(d);
+  const double rb = parameters_.radius_ratio * 0.5 * (p.radius[i] + p.radius[j]);
+  const double S = std::numbers::pi * rb * rb;
+  const double I = 0.25 * std::numbers::pi * rb * rb * rb * rb;
+  const double J = 2.0 * I;
+  const double G = parameters_.young / (2.0 * (1.0 + parameters_.poisson));
+  first_.push_back(i);
+  second_.push_back(j);
+  rest_length_.push_back(L0);
+  axial_.push_back(parameters_.young * S / L0);
+  bending_.push_back(2.0 * parameters_.young * I / L0);
+  torsion_.push_back(G * J / L0);
+  direction_.push_back(d / L0);
+  normal_.push_back(perpendicular_to(d / L0));
+}
+
+void BeamBondSet::finalize(std::size_t n_particles) {
+  const auto order = colouring_.build(first_, second_, n_particles);
+  apply_order(first_, order);
+  apply_order(second_, order);
+  apply_order(rest_length_, order);
+  apply_order(axial_, order);
+  apply_order(bending_, order);
+  apply_order(torsion_, order);
+  apply_order(direction_, order);
+  apply_order(normal_, order);
+}
+
+BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
+  const std::uint32_t i = first_[b], j = second_[b];
+  const Quat& qi = p.orientation[i];
+  const Quat& qj = p.orientation[j];
+  Actions a;
+  const Vec3 d = p.position[j] - p.position[i];
+  a.length = norm(d);
+  a.axis = d / a.length;
+  a.theta_a = rotation_between(a.axis, rotate(qi, direction_[b]));
+  a.theta_b = rotation_between(a.axis, rotate(qj, direction_[b]));
+  // Twist about the axis between the two body-fixed copies of p0; the components of p
+  // along the axis drop out of the triple product, only the cosine term needs them.
+  const Vec3 pi = rotate(qi, normal_[b]), pj = rotate(qj, normal_[b]);
+  a.twist = std::atan2(dot(a.axis, cross(pi, pj)), dot(pi, pj) - dot(pi, a.axis) * dot(pj, a.axis));
+
+  a.axial_force = axial_[b] * (a.length - rest_length_[b]);
+  const double kb = bending_[b];
+  const double torsion_moment = torsion_[b] * a.twist;
+  a.torque_on_i = -kb * (2.0 * a.theta_a + a.theta_b) + torsion_moment * a.axis;
+  a.torque_on_j = -kb * (a.theta_a + 2.0 * a.theta_b) - torsion_moment * a.axis;
+  a.force_on_j = -a.axial_force * a.axis + cross(a.axis, a.torque_on_i + a.torque_on_j) / a.length;
+  return a;
+}
+
+void BeamBondSet::accumulate_forces(ParticleSet& p) const {
+  for_each_bond(colouring_, [&](std::size_t b) {
+    const Actions a = actions(b, p);
+    const std::uint32_t i = first_[b], j = second_[b];
+    p.force[i] -= a.force_on_j;
+    p.force[j] += a.force_on_j;
+    p.torque[i] += a.torque_on_i;
+    p.torque[j] += a.torque_on_j;
+  });
+}
+
+double BeamBondSet::energy(const ParticleSet& p) const {
+  double e = 0.0;
+#pragma omp parallel for reduction(+ : e) schedule(static)
+  for (long bl = 0; bl < static_cast<long>(size()); ++bl) {
+    const auto b = static_cast<std::size_t>(bl);
+    const Actions a = actions(b, p);
+    const double stretch = a.length - rest_length_[b];
+    e += 0.5 * axial_[b] * stretch * stretch +
+         bending_[b] * (norm2(a.theta_a) + dot(a.theta_a, a.theta_b) + norm2(a.theta_b)) +
+         0.5 * torsion_[b] * a.twist * a.twist;
+  }
+  return e;
+}
+
+void BeamBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
+                                       std::span<double> rotational) const {
+  for (std::size_t b = 0; b < size(); ++b) {
+    const double L0 = rest_length_[b], kb = bending_[b], kt = torsion_[b];
+    const double k_trans = std::max(axial_[b], 6.0 * kb / (L0 * L0));  // E S/L, 12 E I/L^3
+    const double k_cross = 3.0 * kb / L0;                               // 6 E I / L^2
+    const double k_rot_own = std::max(2.0 * kb, kt);                    // 4 E I / L, G J / L
+    const double k_rot_other = std::max(kb, kt);                        // 2 E I / L, G J / L
+    for (int end = 0; end < 2; ++end) {
+      const std::uint32_t i = end == 0 ? first_[b] : second_[b];
+      const std::uint32_t j = end == 0 ? second_[b] : first_[b];
+      const double mi = p.inv_mass[i], mj = p.inv_mass[j];
+      const double Ii = p.inv_inertia[i], Ij = p.inv_inertia[j];
+      translational[i] += k_trans * (mi + std::sqrt(mi * mj)) +
+                          k_cross * (std::sqrt(mi * Ii) + std::sqrt(mi * Ij));
+      rotational[i] += k_rot_own * Ii + k_rot_other * std::sqrt(Ii * Ij) +
+                       k_cross * (std::sqrt(Ii * mi) + std::sqrt(Ii * mj));
+    }
+  }
+}
+
+}  // namespace arlequin::dem

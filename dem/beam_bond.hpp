@@ -1,0 +1,67 @@
+// Cohesive Euler-Bernoulli beam bond (law name "beam").
+//
+// Reference: D. Andre, I. Iordanoff, J.-L. Charles, J. Neauport, "Discrete element method to
+// simulate continuous material by using the cohesive beam model", CMAME 213-216 (2012) 113-125.
+//
+// Parameters (case file dem.material.bond):
+//   E_mu   [Pa]  Young's modulus of the beam
+//   nu_mu  [1]   Poisson's ratio of the beam, G_mu = E_mu / (2 (1 + nu_mu))
+//   r_mu   [1]   beam radius over mean DE radius: r_b = r_mu (R_i + R_j) / 2
+// Section: S = pi r_b^2, I = pi r_b^4 / 4, J = 2 I; reference length L0 = |x_j - x_i| at add().
+//
+// Kinematics, co-rotated frame: axis n = (x_j - x_i)/L. Each DE carries a body-fixed copy
+// of the reference direction d0; theta_a (theta_b) is the rotation vector turning n onto DE
+// i's (j's) copy: the end rotations relative to the chord. The twist phi is the angle about
+// n between the two body-fixed copies of a reference vector p0 perpendicular to d0.
+// Generalised forces (linear beam element in the chord frame, stiffness from L0):
+//   N   = E S (L - L0) / L0                      axial, tension > 0
+//   M_a = 2 E I / L0 (2 theta_a + theta_b)       moment to hold end i
+//   M_b = 2 E I / L0 (theta_a + 2 theta_b)       moment to hold end j
+//   M_t = G J phi / L0                           torsion
+// The shear force follows from moment balance, V_j = n x (m_i + m_j) / L (magnitude
+// 6 E I (theta_a + theta_b) / L^2), so angular momentum is conserved to round-off.
+// Energy: E S (L - L0)^2 / (2 L0) + 2 E I / L0 (|ta|^2 + ta.tb + |tb|^2) + G J phi^2 / (2 L0).
+#pragma once
+#include "dem/bond_set.hpp"
+
+namespace arlequin::dem {
+
+class BeamBondSet final : public BondSet {
+ public:
+  struct Parameters {
+    double young = 0.0;         // E_mu, Pa
+    double poisson = 0.3;       // nu_mu
+    double radius_ratio = 0.5;  // r_mu
+  };
+  explicit BeamBondSet(const Parameters& parameters) : parameters_(parameters) {}
+  static std::unique_ptr<BondSet> make(CaseNode& section);
+
+  std::string_view law() const override { return "beam"; }
+  void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
+  void finalize(std::size_t n_particles) override;
+  void accumulate_forces(ParticleSet& p) const override;
+  double energy(const ParticleSet& p) const override;
+  void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
+                            std::span<double> rotational) const override;
+
+  // The generalised forces of bond b in the current configuration (for tests, sensors and
+  // failure criteria): forces and torques exerted by the bond on its two DEs.
+  struct Actions {
+    double length, axial_force, twist;
+    Vec3 axis, theta_a, theta_b;
+    Vec3 force_on_j, torque_on_i, torque_on_j;  // force on i is -force_on_j
+  };
+  Actions actions(std::size_t b, const ParticleSet& p) const;
+  const Parameters& parameters() const { return parameters_; }
+
+ private:
+  Parameters parameters_;
+  std::vector<double> rest_length_;   // L0, m
+  std::vector<double> axial_;         // E S / L0, N/m
+  std::vector<double> bending_;       // 2 E I / L0, N m
+  std::vector<double> torsion_;       // G J / L0, N m
+  std::vector<Vec3> direction_;       // d0 (reference axis), unit
+  std::vector<Vec3> normal_;          // p0 (perpendicular to d0), unit
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,37 @@
+#include "dem/bond_set.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <numeric>
+#include <stdexcept>
+
+namespace arlequin::dem {
+
+std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> first,
+                                                std::span<const std::uint32_t> second,
+                                                std::size_t n_particles) {
+  const std::size_t n = first.size();
+  std::vector<std::uint64_t> used(n_particles, 0);  // colours already taken at each DE
+  std::vector<std::uint8_t> colour(n);
+  int n_colours = 0;
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::uint64_t taken = used[first[b]] | used[second[b]];
+    if (taken == ~std::uint64_t{0}) throw std::length_error("bond colouring: more than 64 colours");
+    const int c = std::countr_one(taken);
+    colour[b] = static_cast<std::uint8_t>(c);
+    used[first[b]] |= std::uint64_t{1} << c;
+    used[second[b]] |= std::uint64_t{1} << c;
+    n_colours = std::max(n_colours, c + 1);
+  }
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return colour[a] != colour[b] ? colour[a] < colour[b] : first[a] < first[b];
+  });
+  offsets.assign(n_colours + 1, 0);
+  for (std::size_t b = 0; b < n; ++b) ++offsets[colour[b] + 1];
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  return order;
+}
+
+}  // namespace arlequin::dem

@@ -1,0 +1,87 @@
+// A batch of bonds of one law and one material: the unit of work for bond forces.
+//
+// Contract: add() records a bond in the current configuration, which becomes its stress-free
+// reference; both DEs must still have their reference (identity) orientation, because laws
+// store reference directions once per bond instead of once per end. finalize() is called
+// once after the last add() and before the first force evaluation. accumulate_forces() adds
+// (never overwrites) forces and torques: one virtual call per batch, none per bond.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dem/particles.hpp"
+
+namespace arlequin {
+class CaseNode;
+}
+
+namespace arlequin::dem {
+
+// Bonds are split into colours so that no two bonds of a colour share a DE: each colour is
+// a parallel loop that scatters forces without atomics, and the summation order per DE is the
+// same for any thread count (results do not depend on OMP_NUM_THREADS).
+struct BondColouring {
+  std::vector<std::uint32_t> offsets;  // colour k holds bonds [offsets[k], offsets[k+1])
+
+  // Greedy edge colouring of (first, second); returns the permutation that sorts bonds by
+  // (colour, first) and fills offsets. Throws std::length_error beyond 64 colours.
+  std::vector<std::uint32_t> build(std::span<const std::uint32_t> first,
+                                   std::span<const std::uint32_t> second, std::size_t n_particles);
+};
+
+// Reorders v so that v_new[k] = v_old[order[k]].
+template <class T>
+void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
+  std::vector<T> sorted(v.size());
+  for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = v[order[k]];
+  v.swap(sorted);
+}
+
+// Runs body(b) for every bond, colour by colour, each colour split over threads.
+template <class Body>
+void for_each_bond(const BondColouring& colouring, Body&& body) {
+  for (std::size_t c = 0; c + 1 < colouring.offsets.size(); ++c) {
+    const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
+#pragma omp parallel for schedule(static)
+    for (long b = begin; b < end; ++b) body(static_cast<std::size_t>(b));
+  }
+}
+
+class BondSet {
+ public:
+  virtual ~BondSet() = default;
+  virtual std::string_view law() const = 0;
+  virtual void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) = 0;
+  virtual void finalize(std::size_t n_particles) = 0;
+  virtual void accumulate_forces(ParticleSet& p) const = 0;
+  // Elastic energy stored in the batch, J.
+  virtual double energy(const ParticleSet& p) const = 0;
+  // Adds to every DE's row the block-Gershgorin bound of omega^2 (rad^2/s^2) coming from this
+  // batch, for its translational and rotational rows of M^-1/2 K M^-1/2 (Feingold-Varga:
+  // lambda_max <= max_i sum_j ||A_ij||_2).
+  virtual void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
+                                    std::span<double> rotational) const = 0;
+
+  std::size_t size() const { return first_.size(); }
+  std::span<const std::uint32_t> first() const { return first_; }
+  std::span<const std::uint32_t> second() const { return second_; }
+
+ protected:
+  std::vector<std::uint32_t> first_, second_;
+  BondColouring colouring_;
+};
+
+// Registry of bond laws, keyed by the case-file name (dem.material.bond.law).
+struct BondLawEntry {
+  std::string_view name;
+  std::string_view summary;
+  std::unique_ptr<BondSet> (*make)(CaseNode& parameters);
+};
+std::span<const BondLawEntry> bond_laws();
+std::unique_ptr<BondSet> make_bond_set(CaseNode& bond_section);
+
+}  // namespace arlequin::dem

@@ -1,0 +1,37 @@
+// Boundary conditions on groups of DEs, applied from t = 0.
+//
+//   fixed         x = x_ref, v = 0, rotation locked (clamped)
+//   velocity      v = value (m/s); x = x_ref + value t
+//   displacement  linear ramp to value (m) over ramp (s), then held: v = value/ramp, then 0
+//   force         total force value (N) shared equally by the group's DEs (a dead load)
+//   free          nothing imposed; declares that the group must not be constrained
+// Kinematic conditions (fixed, velocity, displacement) lock rotations when rotation: fixed
+// (default for fixed, free otherwise). Force sensors report the quasi-static reaction,
+// -(sum of bond and contact forces on the group); the external work of a kinematic condition
+// is the kinetic energy it injects or removes when it overrides velocities.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/vec3.hpp"
+
+namespace arlequin::dem {
+
+enum class BoundaryKind { fixed, velocity, displacement, force, free };
+
+struct BoundaryCondition {
+  std::string group;
+  BoundaryKind kind = BoundaryKind::free;
+  Vec3 value{};             // m/s, m or N depending on kind
+  double ramp = 0.0;        // s, displacement only
+  bool lock_rotation = false;
+
+  bool kinematic() const {
+    return kind == BoundaryKind::fixed || kind == BoundaryKind::velocity || kind == BoundaryKind::displacement;
+  }
+  Vec3 displacement_at(double t) const;
+  Vec3 velocity_at(double t) const;
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,249 @@
+#include "dem/dem_model.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/error.hpp"
+
+namespace arlequin::dem {
+
+int DemModel::add_group(const std::string& name) {
+  if (const int g = group_index(name); g >= 0) return g;
+  if (group_names_.size() >= static_cast<std::size_t>(max_groups))
+    throw std::invalid_argument("too many groups (at most 32)");
+  group_names_.push_back(name);
+  return static_cast<int>(group_names_.size()) - 1;
+}
+
+int DemModel::group_index(const std::string& name) const {
+  const auto it = std::find(group_names_.begin(), group_names_.end(), name);
+  return it == group_names_.end() ? -1 : static_cast<int>(it - group_names_.begin());
+}
+
+std::vector<std::uint32_t> DemModel::members(int group) const {
+  std::vector<std::uint32_t> out;
+  const GroupMask bit = GroupMask{1} << group;
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    if (particles.groups[i] & bit) out.push_back(static_cast<std::uint32_t>(i));
+  return out;
+}
+
+BondSet& DemModel::add_bond_set(std::unique_ptr<BondSet> set) {
+  bond_sets_.push_back(std::move(set));
+  return *bond_sets_.back();
+}
+
+void DemModel::set_contact(std::unique_ptr<ContactLaw> law, double skin) {
+  contact_ = std::move(law);
+  neighbours_.emplace(skin);
+}
+
+void DemModel::add_boundary(const BoundaryCondition& bc) { boundaries_.push_back(bc); }
+
+void DemModel::finalize() {
+  // Boundary conditions: each DE gets at most one; a contradiction names both conditions.
+  std::vector<int> owner(particles.size(), -1);
+  for (std::size_t c = 0; c < boundaries_.size(); ++c) {
+    const BoundaryCondition& bc = boundaries_[c];
+    const int g = group_index(bc.group);
+    if (g < 0) throw std::invalid_argument("unknown group '" + bc.group + "'");
+    const auto ids = members(g);
+    if (ids.empty()) throw std::invalid_argument("group '" + bc.group + "' has no DE");
+    for (std::uint32_t i : ids) {
+      if (owner[i] >= 0) {
+        std::ostringstream msg;
+        msg << "DE " << i << " is in group '" << boundaries_[owner[i]].group << "' (boundary["
+            << owner[i] << "]) and group '" << bc.group << "' (boundary[" << c
+            << "]): one DE can take only one boundary condition";
+        throw std::invalid_argument(msg.str());
+      }
+      owner[i] = static_cast<int>(c);
+      if (bc.kinematic()) constraints_.push_back({i, static_cast<std::uint32_t>(c)});
+      if (bc.kind == BoundaryKind::force) {
+        loaded_.push_back({i, static_cast<std::uint32_t>(c)});
+        load_per_particle_.push_back(bc.value / static_cast<double>(ids.size()));
+      }
+    }
+  }
+  for (auto& set : bond_sets_) set->finalize(particles.size());
+  if (neighbours_) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> bonded;
+    for (const auto& set : bond_sets_)
+      for (std::size_t b = 0; b < set->size(); ++b) bonded.emplace_back(set->first()[b], set->second()[b]);
+    neighbours_->set_exclusions(std::move(bonded));
+    neighbours_->build(particles);
+  }
+  compute_forces();
+  record_reactions();
+  apply_loads_and_damping();
+}
+
+double DemModel::critical_time_step() const {
+  const std::size_t n = particles.size();
+  std::vector<double> trans(n, 0.0), rot(n, 0.0);
+  for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, trans, rot);
+  if (contact_ && n > 0) {
+    std::vector<int> count(n, 0);
+    if (neighbours_)
+      for (auto [i, j] : neighbours_->pairs()) ++count[i], ++count[j];
+    const double inv_m_max = *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end());
+    for (std::size_t i = 0; i < n; ++i)
+      trans[i] += contact_->stiffness() * std::max(1, count[i]) *
+                  (particles.inv_mass[i] + std::sqrt(particles.inv_mass[i] * inv_m_max));
+  }
+  double omega2 = 0.0;
+  for (std::size_t i = 0; i < n; ++i) omega2 = std::max({omega2, trans[i], rot[i]});
+  return omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+}
+
+void DemModel::step(double dt) {
+  last_dt_ = dt;
+  kick(0.5 * dt);                     // v(n+1/2) = v(n) + dt/2 a(n)
+  impose_motion(time_, true, dt);     // driven DEs move exactly by u(t+dt) - u(t)
+  drift(dt);                          // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
+  time_ += dt;
+  update_neighbours();                // only with contact, only when a DE moved > skin/2
+  compute_forces();                   // bonds, contacts -> f(n+1)
+  record_reactions();                 // reactions of watched groups, for sensors
+  apply_loads_and_damping();          // dead loads, viscous damping
+  kick(0.5 * dt);                     // v(n+1) = v(n+1/2) + dt/2 a(n+1)
+  impose_motion(time_, false, dt);    // driven DEs: v = du/dt(t(n+1))
+  ++steps_;
+}
+
+void DemModel::kick(double half_dt) {
+  ParticleSet& p = particles;
+  const long n = static_cast<long>(p.size());
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) {
+    p.velocity[i] += p.force[i] * (half_dt * p.inv_mass[i]);
+    p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia[i]);
+  }
+}
+
+void DemModel::impose_motion(double t, bool half_step, double dt) {
+  // The constraint's work is exactly the kinetic energy it adds or removes when it overrides
+  // a velocity (over a step this equals the reaction's work R . dx plus the impulse that
+  // starts or stops a driven DE).
+  ParticleSet& p = particles;
+  for (const Constraint& c : constraints_) {
+    const BoundaryCondition& bc = boundaries_[c.condition];
+    const std::uint32_t i = c.particle;
+    const Vec3 v = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+    external_work_ += 0.5 * p.mass(i) * (norm2(v) - norm2(p.velocity[i]));
+    p.velocity[i] = v;
+    if (bc.lock_rotation) {
+      external_work_ -= 0.5 * p.inertia(i) * norm2(p.angular_velocity[i]);
+      p.angular_velocity[i] = {};
+    }
+  }
+}
+
+void DemModel::drift(double dt) {
+  ParticleSet& p = particles;
+  const long n = static_cast<long>(p.size());
+#pragma omp parallel for schedule(static)
+  for (long i = 0; i < n; ++i) {
+    p.position[i] += p.velocity[i] * dt;
+    // Spheres: omega is constant over the drift, so the rotation is exact.
+    if (norm2(p.angular_velocity[i]) > 0.0)
+      p.orientation[i] = normalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
+  }
+}
+
+void DemModel::update_neighbours() {
+  if (neighbours_ && neighbours_->needs_rebuild(particles)) neighbours_->build(particles);
+}
+
+void DemModel::compute_forces() {
+  particles.clear_forces();
+  for (const auto& set : bond_sets_) set->accumulate_forces(particles);
+  if (contact_) contact_->accumulate_forces(*neighbours_, particles);
+}
+
+void DemModel::record_reactions() {
+  const ParticleSet& p = particles;
+  if (watched_) {
+    for (auto& r : reaction_) r = {};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      for (GroupMask m = p.groups[i] & watched_; m; m &= m - 1) reaction_[std::countr_zero(m)] -= p.force[i];
+    }
+  }
+}
+
+void DemModel::apply_loads_and_damping() {
+  ParticleSet& p = particles;
+  for (std::size_t k = 0; k < loaded_.size(); ++k) {
+    const std::uint32_t i = loaded_[k].particle;
+    p.force[i] += load_per_particle_[k];
+    external_work_ += dot(load_per_particle_[k], p.velocity[i]) * last_dt_;
+  }
+  if (damping_ > 0.0) {
+    double power = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double m = p.mass(i), inertia = p.inertia(i);
+      p.force[i] -= p.velocity[i] * (damping_ * m);
+      p.torque[i] -= p.angular_velocity[i] * (damping_ * inertia);
+      power += damping_ * (m * norm2(p.velocity[i]) + inertia * norm2(p.angular_velocity[i]));
+    }
+    dissipated_ += power * last_dt_;
+  }
+}
+
+Energies DemModel::energies() const {
+  Energies e;
+  const ParticleSet& p = particles;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    e.kinetic += 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
+  for (const auto& set : bond_sets_) e.bond += set->energy(p);
+  if (contact_) e.contact = contact_->energy(*neighbours_, p);
+  e.external_work = external_work_;
+  e.dissipated = dissipated_;
+  return e;
+}
+
+Vec3 DemModel::mean_displacement(int group) const {
+  Vec3 sum{};
+  std::size_t count = 0;
+  const GroupMask bit = GroupMask{1} << group;
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    if (particles.groups[i] & bit) {
+      sum += particles.position[i] - particles.reference[i];
+      ++count;
+    }
+  return count ? sum / static_cast<double>(count) : Vec3{};
+}
+
+void DemModel::check_health(double energy_limit) const {
+  const ParticleSet& p = particles;
+  std::size_t worst = 0;
+  double worst_energy = -1.0;
+  double kinetic = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!is_finite(p.position[i]) || !is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
+      std::ostringstream msg;
+      msg << "step " << steps_ << " (t = " << time_ << " s): DE " << i
+          << " has a non-finite position or velocity; likely cause: a time step above the "
+             "stability limit, or an initial overlap far too deep for the contact stiffness";
+      throw RunError(msg.str());
+    }
+    const double e = 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
+    kinetic += e;
+    if (e > worst_energy) worst_energy = e, worst = i;
+  }
+  if (kinetic > energy_limit) {
+    std::ostringstream msg;
+    msg << "step " << steps_ << " (t = " << time_ << " s): kinetic energy " << kinetic
+        << " J exceeds the blow-up limit " << energy_limit << " J (fastest DE: " << worst
+        << " at " << p.position[worst].x << ", " << p.position[worst].y << ", " << p.position[worst].z
+        << "); likely cause: a time step too close to the stability limit for the stiffest "
+           "bond or contact, or energy injected by boundary conditions";
+    throw RunError(msg.str());
+  }
+}
+
+}  // namespace arlequin::dem

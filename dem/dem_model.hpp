@@ -1,0 +1,105 @@
+// The DEM model: particles, bond batches, optional contact, boundary conditions, and the
+// explicit velocity-Verlet step with rotations (DESIGN.md section 2).
+//
+// Contract: build with add_group / add_bond_set / set_contact / add_boundary / set_damping,
+// then finalize() once (checks boundary conditions, colours bonds, builds the neighbour list
+// only if there is a contact law), then step(). Throws std::invalid_argument from finalize()
+// for contradictory setups (the application adds the case-file location), RunError from
+// check_health() when the run has gone non-finite or blown up.
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dem/bond_set.hpp"
+#include "dem/boundary.hpp"
+#include "dem/contact_law.hpp"
+#include "dem/neighbour_list.hpp"
+#include "dem/particles.hpp"
+
+namespace arlequin::dem {
+
+struct Energies {
+  double kinetic = 0.0;        // translational + rotational, J
+  double bond = 0.0;           // elastic energy in bonds, J
+  double contact = 0.0;        // elastic energy in contacts, J
+  double external_work = 0.0;  // work done on the model by boundary conditions and loads, J
+  double dissipated = 0.0;     // by viscous damping, J
+  double total() const { return kinetic + bond + contact; }
+};
+
+class DemModel {
+ public:
+  ParticleSet particles;
+
+  // Groups: up to 32 names, membership in particles.groups bits.
+  int add_group(const std::string& name);
+  int group_index(const std::string& name) const;  // -1 if unknown
+  const std::vector<std::string>& group_names() const { return group_names_; }
+  std::vector<std::uint32_t> members(int group) const;
+
+  BondSet& add_bond_set(std::unique_ptr<BondSet> set);
+  const std::vector<std::unique_ptr<BondSet>>& bond_sets() const { return bond_sets_; }
+  void set_contact(std::unique_ptr<ContactLaw> law, double skin);
+  bool has_contact() const { return contact_ != nullptr; }
+  const NeighbourList* neighbours() const { return neighbours_ ? &*neighbours_ : nullptr; }
+  void add_boundary(const BoundaryCondition& bc);
+  // Viscous damping, force -c m v and torque -c I omega, c in 1/s (quasi-static runs).
+  void set_damping(double coefficient) { damping_ = coefficient; }
+  // Reaction forces of this group are recorded every step (for force sensors).
+  void watch_reaction(int group) { watched_ |= GroupMask{1} << group; }
+
+  void finalize();
+
+  // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
+  // bonds and contacts (DESIGN.md section 3). Contacts count as many per DE as it has
+  // neighbours at setup (at least one), with the stiffness of the contact law.
+  double critical_time_step() const;
+
+  // One velocity-Verlet step of size dt (s): the phases, in order.
+  void step(double dt);
+  double time() const { return time_; }
+  long steps_done() const { return steps_; }
+
+  Energies energies() const;
+  double external_work() const { return external_work_; }  // J, cheap (no energy sums)
+  // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
+  Vec3 reaction_on(int group) const { return reaction_[group]; }
+  Vec3 mean_displacement(int group) const;
+  // Throws RunError naming the step, the DE and the likely cause if anything is
+  // non-finite or the kinetic energy exceeds `energy_limit` (J).
+  void check_health(double energy_limit) const;
+
+ private:
+  void kick(double half_dt);
+  void impose_motion(double t, bool half_step, double dt);
+  void drift(double dt);
+  void update_neighbours();
+  void compute_forces();
+  void record_reactions();
+  void apply_loads_and_damping();
+
+  struct Constraint {
+    std::uint32_t particle;
+    std::uint32_t condition;  // index into boundaries_
+  };
+  std::vector<std::string> group_names_;
+  std::vector<std::unique_ptr<BondSet>> bond_sets_;
+  std::unique_ptr<ContactLaw> contact_;
+  std::optional<NeighbourList> neighbours_;
+  std::vector<BoundaryCondition> boundaries_;
+  std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
+  std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
+  std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
+  GroupMask watched_ = 0;
+  Vec3 reaction_[max_groups]{};
+  double damping_ = 0.0;
+  double time_ = 0.0;
+  double last_dt_ = 0.0;  // s, step size of the step in progress (0 before the first)
+  long steps_ = 0;
+  double external_work_ = 0.0;
+  double dissipated_ = 0.0;
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,37 @@
+// Verlet list of candidate contact pairs, built from a cell list with a skin.
+//
+// Contract: after build(), pairs() holds every pair i < j, not excluded, whose surfaces are
+// closer than `skin` (|x_i - x_j| < R_i + R_j + skin). The list stays valid while no DE has
+// moved more than skin/2 since the build; needs_rebuild() checks exactly that.
+#pragma once
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "dem/particles.hpp"
+
+namespace arlequin::dem {
+
+class NeighbourList {
+ public:
+  explicit NeighbourList(double skin) : skin_(skin) {}
+
+  // Pairs never to list (bonded DEs interact through their bond); i < j in each.
+  void set_exclusions(std::vector<std::pair<std::uint32_t, std::uint32_t>> excluded);
+  void build(const ParticleSet& p);
+  bool needs_rebuild(const ParticleSet& p) const;
+  std::span<const std::pair<std::uint32_t, std::uint32_t>> pairs() const { return pairs_; }
+  std::size_t builds() const { return builds_; }
+  double skin() const { return skin_; }
+
+ private:
+  double skin_;
+  std::vector<std::uint64_t> excluded_;  // sorted keys i * 2^32 + j
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
+  std::vector<Vec3> position_at_build_;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> cells_;  // (cell key, DE), sorted
+  std::size_t builds_ = 0;
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,43 @@
+#include "dem/particles.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+namespace arlequin::dem {
+
+std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
+  const double m = density * 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  position.push_back(x);
+  reference.push_back(x);
+  velocity.push_back({});
+  orientation.push_back({});
+  angular_velocity.push_back({});
+  force.push_back({});
+  torque.push_back({});
+  radius.push_back(r);
+  inv_mass.push_back(1.0 / m);
+  inv_inertia.push_back(1.0 / (0.4 * m * r * r));
+  groups.push_back(0);
+  return size() - 1;
+}
+
+void ParticleSet::clear_forces() {
+  std::fill(force.begin(), force.end(), Vec3{});
+  std::fill(torque.begin(), torque.end(), Vec3{});
+}
+
+void ParticleSet::reserve(std::size_t n) {
+  position.reserve(n);
+  reference.reserve(n);
+  velocity.reserve(n);
+  orientation.reserve(n);
+  angular_velocity.reserve(n);
+  force.reserve(n);
+  torque.reserve(n);
+  radius.reserve(n);
+  inv_mass.reserve(n);
+  inv_inertia.reserve(n);
+  groups.reserve(n);
+}
+
+}  // namespace arlequin::dem

@@ -1,0 +1,44 @@
+// Spherical discrete elements in structure-of-arrays form.
+//
+// Contract: every array has size(); index i is one DE for the whole run (DEs are never
+// reordered or removed, so bond and group indices stay valid). Orientation q maps body to
+// world frame; angular velocity omega is in the world frame. Inertia is the sphere's
+// I = 2/5 m R^2, isotropic, so Euler's equations reduce to d(omega)/dt = torque / I.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "common/quat.hpp"
+#include "common/vec3.hpp"
+
+namespace arlequin::dem {
+
+// Up to 32 named groups; a DE's membership is a bit mask.
+using GroupMask = std::uint32_t;
+inline constexpr int max_groups = 32;
+
+struct ParticleSet {
+  std::vector<Vec3> position;         // m
+  std::vector<Vec3> reference;        // m, position at t = 0 (for displacements)
+  std::vector<Vec3> velocity;         // m/s
+  std::vector<Quat> orientation;      // body -> world
+  std::vector<Vec3> angular_velocity; // rad/s, world frame
+  std::vector<Vec3> force;            // N, accumulated each step
+  std::vector<Vec3> torque;           // N m, accumulated each step
+  std::vector<double> radius;         // m
+  std::vector<double> inv_mass;       // 1/kg
+  std::vector<double> inv_inertia;    // 1/(kg m^2)
+  std::vector<GroupMask> groups;
+
+  std::size_t size() const { return position.size(); }
+
+  // Appends a DE at rest with identity orientation; returns its index.
+  std::size_t add(const Vec3& x, double r, double density);
+
+  double mass(std::size_t i) const { return 1.0 / inv_mass[i]; }
+  double inertia(std::size_t i) const { return 1.0 / inv_inertia[i]; }
+  void clear_forces();
+  void reserve(std::size_t n);
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,148 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <random>
+
+#include "common/error.hpp"
+#include "continuum_test_util.hpp"
+
+using namespace arlequin;
+using namespace arlequin::continuum;
+using namespace arlequin::continuum::testing;
+
+namespace {
+
+// Affine displacement on the whole boundary: interior nodes and stresses must be exact.
+void patch_test(const std::string& method, int order) {
+  const Material mat = Material::isotropic(1e3, 0.3, 1.0);
+  auto s = make_continuum_solver(method, settings("unit_cube.geo", 0.34, order, mat));
+  s->fix("boundary", {true, true, true}, [](const Vec3& x, double) { return affine(x); });
+  s->solve_static("-ksp_type preonly -pc_type lu");
+  double err = 0;
+  for (int n = 0; n < s->num_nodes(); ++n) {
+    const Vec3 e = affine(s->nodes()[n]);
+    for (int c = 0; c < 3; ++c) err = std::max(err, std::abs(s->displacement()[3 * n + c] - e[c]));
+  }
+  EXPECT_LT(err, 1e-10 * 3e-3) << method << " P" << order;
+  const Voigt sigma = mat.C * affine_strain();
+  double serr = 0;
+  for (const Voigt& st : s->point_stress()) serr = std::max(serr, (st - sigma).norm() / sigma.norm());
+  EXPECT_LT(serr, 1e-10) << method << " P" << order;
+}
+
+// Runs `steps` central-difference steps from random velocities at factor * dt_c, returns the
+// largest total energy seen divided by the initial one.
+double energy_growth(const std::string& method, int order, double factor, int steps) {
+  auto s = make_continuum_solver(method, settings("unit_cube.geo", 0.3, order, Material::isotropic(1.0, 0.3, 1.0)));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  for (double& v : s->velocity()) v = uni(rng);
+  s->compute_forces();
+  const double dt = factor * s->critical_time_step();
+  const double e0 = s->kinetic_energy() + s->strain_energy();
+  double emax = e0;
+  try {
+    for (int i = 0; i < steps; ++i) {
+      s->step(dt);
+      emax = std::max(emax, s->kinetic_energy() + s->strain_energy());
+      if (emax > 1e12 * e0) break;
+    }
+  } catch (const RunError&) {
+    return 1e300;
+  }
+  return emax / e0;
+}
+
+}  // namespace
+
+TEST(ContinuumFe, PatchTestP1) { patch_test("fe", 1); }
+TEST(ContinuumFe, PatchTestP2) { patch_test("fe", 2); }
+
+TEST(ContinuumFe, InterpolationOperatorReproducesAffineFields) {
+  for (int order : {1, 2}) {
+    auto s = make_continuum_solver("fe", settings("unit_cube.geo", 0.4, order, Material::isotropic(1, 0.3, 1)));
+    std::vector<Vec3> pts;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> uni(0, 1);
+    for (int i = 0; i < 200; ++i) pts.push_back({uni(rng), uni(rng), uni(rng)});
+    pts.push_back({1, 1, 1});
+    pts.push_back({0, 0.5, 1});
+    const InterpolationOperator N = s->interpolation(pts);
+    Eigen::VectorXd ux(s->num_nodes()), uy(s->num_nodes()), uz(s->num_nodes());
+    for (int n = 0; n < s->num_nodes(); ++n) {
+      const Vec3 u = affine(s->nodes()[n]);
+      ux[n] = u.x, uy[n] = u.y, uz[n] = u.z;
+    }
+    const Eigen::VectorXd ix = N * ux, iy = N * uy, iz = N * uz;
+    const Eigen::VectorXd one = N * Eigen::VectorXd::Ones(s->num_nodes());
+    for (size_t p = 0; p < pts.size(); ++p) {
+      const Vec3 e = affine(pts[p]);
+      EXPECT_NEAR(one[p], 1.0, 1e-13);
+      EXPECT_NEAR(ix[p], e.x, 1e-15);
+      EXPECT_NEAR(iy[p], e.y, 1e-15);
+      EXPECT_NEAR(iz[p], e.z, 1e-15);
+    }
+    EXPECT_THROW(s->interpolation({{1.1, 0.5, 0.5}}), InputError);
+  }
+}
+
+TEST(ContinuumFe, WeightedLumpedMassIntegratesAlphaRho) {
+  for (int order : {1, 2}) {
+    auto s = make_continuum_solver("fe", settings("unit_cube.geo", 0.4, order, Material::isotropic(1, 0.3, 2.0)));
+    double m = 0;
+    for (double mi : s->lumped_mass()) {
+      EXPECT_GT(mi, 0.0);
+      m += mi;
+    }
+    EXPECT_NEAR(m, 2.0, 1e-12);
+    s->set_weight([](const Vec3& x) { return x.x; });  // int_cube rho x = 1
+    m = 0;
+    for (double mi : s->lumped_mass()) m += mi;
+    EXPECT_NEAR(m, 1.0, 1e-12);
+    // The weight also scales the strain energy: alpha = 1/2 halves it.
+    for (int n = 0; n < s->num_nodes(); ++n) s->displacement()[3 * n] = 1e-3 * s->nodes()[n].x;
+    s->set_weight([](const Vec3&) { return 1.0; });
+    const double e1 = s->strain_energy();
+    s->set_weight([](const Vec3&) { return 0.5; });
+    EXPECT_NEAR(s->strain_energy(), 0.5 * e1, 1e-14 * e1);
+  }
+}
+
+TEST(ContinuumFe, ExplicitStableBelowCriticalStep) {
+  for (int order : {1, 2}) {
+    EXPECT_LT(energy_growth("fe", order, 0.9, 1500), 20.0) << "P" << order;
+    // The estimate is not needlessly small: 10 % above it the top mode blows up.
+    EXPECT_GT(energy_growth("fe", order, 1.1, 1500), 1e6) << "P" << order;
+  }
+}
+
+TEST(ContinuumFe, BarWaveFrontSpeed) {
+  // nu = 0: the bar's longitudinal wave speed is sqrt(E / rho) for any cross-section.
+  const double E = 2.0, rho = 0.5, c = std::sqrt(E / rho), v0 = 1e-3;
+  for (int order : {1, 2}) {
+    auto s = make_continuum_solver("fe", settings("bar.geo", order == 1 ? 0.02 : 0.025, order, Material::isotropic(E, 0.0, rho)));
+    s->fix("left", {true, false, false}, [&](const Vec3&, double t) { return Vec3{v0 * t, 0, 0}; });
+    s->compute_forces();
+    const double dt = 0.9 * s->critical_time_step();
+    std::vector<Vec3> line;
+    for (int i = 0; i <= 2000; ++i) line.push_back({i / 2000.0, 0.05, 0.05});
+    const InterpolationOperator N = s->interpolation(line);
+    auto front = [&]() {
+      Eigen::VectorXd vx(s->num_nodes());
+      for (int n = 0; n < s->num_nodes(); ++n) vx[n] = s->velocity()[3 * n];
+      const Eigen::VectorXd v = N * vx;
+      for (int i = static_cast<int>(line.size()) - 1; i > 0; --i)
+        if (v[i - 1] >= 0.5 * v0) {  // linear interpolation of the half-height crossing
+          const double f = (v[i - 1] - 0.5 * v0) / (v[i - 1] - v[i]);
+          return line[i - 1].x + f * (line[i].x - line[i - 1].x);
+        }
+      return 0.0;
+    };
+    const double t1 = 0.25 / c, t2 = 0.75 / c;
+    while (s->time() < t1) s->step(std::min(dt, t1 - s->time()));
+    const double x1 = front();
+    while (s->time() < t2) s->step(std::min(dt, t2 - s->time()));
+    const double x2 = front();
+    EXPECT_NEAR((x2 - x1) / (t2 - t1), c, 0.02 * c) << "P" << order;
+  }
+}

@@ -1,0 +1,77 @@
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "continuum/mesh.hpp"
+#include "continuum_test_util.hpp"
+
+using namespace arlequin;
+using namespace arlequin::continuum;
+using arlequin::continuum::testing::mesh_path;
+
+TEST(ContinuumMesh, GeoIsMeshedWithNamedGroups) {
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1});
+  EXPECT_EQ(m.order(), 1);
+  EXPECT_NEAR(m.volume(), 1.0, 1e-12);
+  EXPECT_EQ(m.group("domain").dim, 3);
+  EXPECT_EQ(static_cast<int>(m.group("domain").tets.size()), m.num_tets());
+  for (int n : m.group("xmax").nodes) EXPECT_NEAR(m.nodes()[n].x, 1.0, 1e-12);
+  EXPECT_GT(m.group("boundary").triangles.size(), m.group("xmin").triangles.size());
+  EXPECT_EQ(m.boundary_triangles().size(), m.group("boundary").triangles.size());
+}
+
+TEST(ContinuumMesh, QuadraticEdgeNodesAreMidpoints) {
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 2});
+  ASSERT_EQ(m.order(), 2);
+  for (int e = 0; e < m.num_tets(); ++e)
+    for (int k = 0; k < 6; ++k) {
+      const Vec3 mid = 0.5 * (m.nodes()[m.tet(e)[kTetEdges[k][0]]] + m.nodes()[m.tet(e)[kTetEdges[k][1]]]);
+      EXPECT_LT(norm(m.nodes()[m.tet(e)[4 + k]] - mid), 1e-12);
+    }
+}
+
+TEST(ContinuumMesh, ProblemsAreClearErrors) {
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1});
+  try {
+    m.group("nonexistent");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("xmin"), std::string::npos);  // lists the known names
+  }
+  EXPECT_THROW(Mesh::load({mesh_path("no_such_mesh.geo"), 0.5, 1}), InputError);
+  // Inverted tetrahedron.
+  std::vector<Vec3> x{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  EXPECT_NO_THROW(Mesh(1, x, {0, 1, 2, 3}, {}));
+  EXPECT_THROW(Mesh(1, x, {0, 2, 1, 3}, {}), InputError);
+  // Empty region.
+  PhysicalGroup empty{"hole", 3, {}, {}, {}};
+  EXPECT_THROW(Mesh(1, x, {0, 1, 2, 3}, {empty}), InputError);
+}
+
+TEST(ContinuumRegistry, NamesAndUnknown) {
+  std::vector<std::string> names;
+  for (const auto& e : continuum_solvers()) names.push_back(e.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"fe", "nem"}));
+  const ContinuumSettings none;
+  EXPECT_THROW(make_continuum_solver("xfem", none), InputError);
+}
+
+TEST(ContinuumMaterial, TransverselyIsotropicCompliance) {
+  // Uniaxial stress along the (oblique) axis: strain along it sigma/E_L, across -nu_LT sigma/E_L.
+  const Vec3 a = normalized(Vec3{1, 2, 2});
+  const Material m = Material::transversely_isotropic(135e9, 9.5e9, 0.3, 0.35, 4e9, a, 1600);
+  const Stiffness S = m.C.inverse();
+  Eigen::Vector3d av(a.x, a.y, a.z);
+  Eigen::Matrix3d sig = av * av.transpose();  // unit stress along a
+  Voigt s;
+  s << sig(0, 0), sig(1, 1), sig(2, 2), sig(1, 2), sig(0, 2), sig(0, 1);
+  const Voigt e = S * s;
+  Eigen::Matrix3d eps;
+  eps << e[0], e[5] / 2, e[4] / 2, e[5] / 2, e[1], e[3] / 2, e[4] / 2, e[3] / 2, e[2];
+  EXPECT_NEAR(av.dot(eps * av) * 135e9, 1.0, 1e-9);
+  const Eigen::Vector3d t = av.cross(Eigen::Vector3d::UnitX()).normalized();
+  EXPECT_NEAR(t.dot(eps * t) * 135e9, -0.3, 1e-9);
+  // Isotropic limit equals the isotropic stiffness.
+  const Material iso = Material::isotropic(2e11, 0.3, 7800);
+  const Material ti = Material::transversely_isotropic(2e11, 2e11, 0.3, 0.3, 2e11 / 2.6, a, 7800);
+  EXPECT_LT((iso.C - ti.C).norm(), 1e-6 * iso.C.norm());
+}

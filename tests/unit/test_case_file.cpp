@@ -1,0 +1,305 @@
+// Case-file reading: typed values, defaults, resolved output, overrides and the one-line
+// error messages (location, key path, what was expected).
+#include "common/case_file.hpp"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <array>
+#include <fstream>
+#include <functional>
+#include <unistd.h>
+
+#include "common/error.hpp"
+
+namespace arlequin {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CaseFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("arlequin_case_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path write(const std::string& text, const std::string& name = "case.yaml") {
+    const fs::path file = dir_ / name;
+    fs::create_directories(file.parent_path());
+    std::ofstream(file) << text;
+    return file;
+  }
+  CaseFile load(const std::string& text, const std::vector<std::string>& overrides = {}) {
+    return CaseFile::load(write(text), overrides);
+  }
+
+  fs::path dir_;
+};
+
+// The message of the InputError thrown by `f` ("" if none was thrown).
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+#define EXPECT_CONTAINS(text, part) \
+  EXPECT_NE(std::string(text).find(part), std::string::npos) << "message: " << (text)
+
+constexpr std::array<std::string_view, 3> kElements{"beam", "shell", "solid"};
+
+const char* const kCase = R"(time:
+  end: 1e-3
+  steps: 200
+dem:
+  sample:
+    radius: 0.001
+    density: 2500
+  gravity: [0, 0, -9.81]
+  periodic: true
+  element: shell
+  name: glass beads
+output:
+  fields: [velocity, stress]
+  every: auto
+)";
+
+TEST_F(CaseFileTest, ReadsTypedValuesAndDefaults) {
+  CaseFile c = load(kCase);
+  CaseNode root = c.root();
+  CaseNode time = root.child("time");
+  EXPECT_DOUBLE_EQ(time.number("end", Range::positive(), "s"), 1e-3);
+  EXPECT_EQ(time.integer("steps", Range::at_least(1)), 200);
+  EXPECT_DOUBLE_EQ(time.number_or("dt", 1e-6, Range::positive(), "s"), 1e-6);
+  EXPECT_EQ(time.integer_or("threads", 4, Range::at_least(1)), 4);
+  time.finish();
+
+  CaseNode dem = root.child("dem");
+  CaseNode sample = dem.child("sample");
+  EXPECT_DOUBLE_EQ(sample.number("radius", Range::positive(), "m"), 0.001);
+  EXPECT_DOUBLE_EQ(sample.number("density", Range::positive(), "kg/m^3"), 2500);
+  sample.finish();
+  const Vec3 g = dem.vec3("gravity", Range::any(), "m/s^2");
+  EXPECT_EQ(g, (Vec3{0, 0, -9.81}));
+  EXPECT_EQ(dem.vec3_or("origin", Vec3{1, 2, 3}, Range::any(), "m"), (Vec3{1, 2, 3}));
+  EXPECT_TRUE(dem.boolean("periodic"));
+  EXPECT_FALSE(dem.boolean_or("restart", false));
+  EXPECT_EQ(dem.choice("element", kElements), "shell");
+  EXPECT_EQ(dem.choice_or("solver", "beam", kElements), "beam");
+  EXPECT_EQ(dem.string("name"), "glass beads");
+  EXPECT_EQ(dem.string_or("label", "none"), "none");
+  EXPECT_FALSE(dem.has("contacts"));
+  EXPECT_FALSE(dem.child_if("contacts").has_value());
+  dem.finish();
+
+  CaseNode output = root.child("output");
+  EXPECT_EQ(output.strings("fields"), (std::vector<std::string>{"velocity", "stress"}));
+  EXPECT_EQ(output.strings_or("groups", {"all"}), (std::vector<std::string>{"all"}));
+  EXPECT_FALSE(output.number_or_auto("every", Range::positive(), "s").has_value());
+  EXPECT_FALSE(output.number_or_auto("interval", Range::positive(), "s").has_value());
+  output.finish();
+  root.finish();
+  EXPECT_EQ(root.keys(), (std::vector<std::string>{"time", "dem", "output"}));
+}
+
+TEST_F(CaseFileTest, ResolvedYamlHasReadValuesAndDefaultsInReadOrder) {
+  CaseFile c = load(kCase);
+  CaseNode root = c.root();
+  CaseNode dem = root.child("dem");
+  dem.child("sample").number("radius", Range::positive(), "m");
+  dem.number_or("damping", 0.05, Range::between(0, 1), "1");
+  dem.vec3("gravity", Range::any(), "m/s^2");
+  root.child("time").number("end", Range::positive(), "s");
+  root.child("output").strings_or("groups", {"all", "true"});
+
+  const std::string text = c.resolved_yaml();
+  EXPECT_CONTAINS(text, "damping: 0.05");
+  EXPECT_CONTAINS(text, "gravity: [0, 0, -9.81]");
+  EXPECT_CONTAINS(text, "\"true\"");  // a string that would read back as a bool is quoted
+  EXPECT_EQ(text.find("density"), std::string::npos) << text;  // never read
+  EXPECT_LT(text.find("dem:"), text.find("time:")) << text;
+
+  const YAML::Node back = YAML::Load(text);
+  EXPECT_DOUBLE_EQ(back["dem"]["sample"]["radius"].as<double>(), 0.001);
+  EXPECT_DOUBLE_EQ(back["time"]["end"].as<double>(), 1e-3);
+  EXPECT_EQ(back["output"]["groups"][1].as<std::string>(), "true");
+}
+
+TEST_F(CaseFileTest, UnknownKeySuggestsClosestWithLine) {
+  CaseFile c = load("dem:\n  radius: 1\n  sampel:\n    radius: 1\n");
+  CaseNode dem = c.root().child("dem");
+  dem.number("radius", Range::positive(), "m");
+  dem.child_if("sample");
+  EXPECT_CONTAINS(error_of([&] { dem.finish(); }),
+                  "case.yaml:3: dem.sampel: unknown key; did you mean 'sample'?");
+}
+
+TEST_F(CaseFileTest, UnknownKeyFarFromAllListsValidKeys) {
+  CaseFile c = load("time:\n  end: 1\n  zzzzzzzz: 2\n");
+  CaseNode time = c.root().child("time");
+  time.number("end", Range::positive(), "s");
+  time.number_or("dt", 1, Range::positive(), "s");
+  EXPECT_CONTAINS(error_of([&] { time.finish(); }),
+                  "case.yaml:3: time.zzzzzzzz: unknown key; valid keys: end, dt");
+}
+
+TEST_F(CaseFileTest, WrongTypeRangeUnitSuffixAndNonInteger) {
+  CaseFile c = load("s:\n  a: abc\n  b: -0.001\n  c: 1 mm\n  d: 2.5\n  e: [1, 2]\n  f: yes\n  g: [1, x, 3]\n");
+  CaseNode s = c.root().child("s");
+  EXPECT_CONTAINS(error_of([&] { s.number("a", Range::positive(), "m"); }),
+                  "case.yaml:2: s.a: expected a number > 0 [m], got 'abc'");
+  EXPECT_CONTAINS(error_of([&] { s.number("b", Range::positive(), "m"); }),
+                  "case.yaml:3: s.b: expected a number > 0 [m], got -0.001");
+  EXPECT_CONTAINS(error_of([&] { s.number("c", Range::positive(), "m"); }),
+                  "case.yaml:4: s.c: expected a number > 0 [m] (SI units, no unit suffix), got '1 mm'");
+  EXPECT_CONTAINS(error_of([&] { s.integer("d", Range::at_least(1)); }),
+                  "case.yaml:5: s.d: expected an integer >= 1, got 2.5");
+  EXPECT_CONTAINS(error_of([&] { s.number("e", Range::between(0, 1), "1"); }),
+                  "s.e: expected a number in [0, 1], got a list of 2 items");
+  EXPECT_CONTAINS(error_of([&] { s.vec3("e", Range::any(), "m"); }),
+                  "s.e: expected a list of 3 numbers [m], got a list of 2 items");
+  EXPECT_CONTAINS(error_of([&] { s.boolean("f"); }), "s.f: expected true or false, got 'yes'");
+  EXPECT_CONTAINS(error_of([&] { s.numbers("g", Range::any(), "Pa"); }),
+                  "case.yaml:8: s.g[1]: expected a number [Pa], got 'x'");
+  EXPECT_CONTAINS(error_of([&] { s.child("a"); }), "s.a: expected a mapping, got 'abc'");
+  EXPECT_CONTAINS(error_of([&] { s.string("e"); }), "s.e: expected a string, got a list of 2 items");
+  EXPECT_CONTAINS(error_of([&] { s.number_or_auto("a", Range::positive(), "s"); }),
+                  "expected a number > 0 [s] or 'auto', got 'abc'");
+}
+
+TEST_F(CaseFileTest, BadChoiceSuggestsClosest) {
+  CaseFile c = load("dem:\n  element: bem\n");
+  CaseNode dem = c.root().child("dem");
+  EXPECT_CONTAINS(error_of([&] { dem.choice("element", kElements); }),
+                  "case.yaml:2: dem.element: expected one of beam, shell, solid, got 'bem'; did you mean 'beam'?");
+}
+
+TEST_F(CaseFileTest, MissingRequiredKeyNamesParentAndKey) {
+  CaseFile c = load("dem:\n  sample:\n    density: 1\n");
+  CaseNode sample = c.root().child("dem").child("sample");
+  EXPECT_CONTAINS(error_of([&] { sample.number("radius", Range::positive(), "m"); }),
+                  "case.yaml:2: dem.sample: missing required key 'radius' (a number > 0 [m])");
+  EXPECT_CONTAINS(error_of([&] { c.root().child("time"); }), "case.yaml:1: missing required key 'time'");
+}
+
+TEST_F(CaseFileTest, MissingFile) {
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(dir_ / "nope.yaml"); }),
+                  "nope.yaml: cannot open case file (No such file or directory)");
+}
+
+TEST_F(CaseFileTest, YamlSyntaxErrorHasLine) {
+  const std::string message = error_of([&] { load("a: 1\nb: [1, 2\nc: 3\n"); });
+  EXPECT_CONTAINS(message, "case.yaml:");
+  EXPECT_CONTAINS(message, ": YAML syntax error: ");
+  EXPECT_EQ(message.find("yaml-cpp: error at"), std::string::npos) << message;
+  EXPECT_CONTAINS(error_of([&] { load("a: {b: 1}\nc:\n  d: 1\n   e: 2\n"); }), "case.yaml:4: YAML syntax error:");
+}
+
+TEST_F(CaseFileTest, DuplicateAndTopLevelKindAreErrors) {
+  EXPECT_CONTAINS(error_of([&] { load("a: 1\nb: 2\na: 3\n").root(); }),
+                  "case.yaml:3: a: duplicate key (first given at line 1)");
+  EXPECT_CONTAINS(error_of([&] { load("- 1\n- 2\n"); }),
+                  "case.yaml:1: expected a mapping of sections at the top level, got a list of 2 items");
+}
+
+TEST_F(CaseFileTest, OverridesReplaceAndCreateValues) {
+  CaseFile c = load(kCase, {"time.end=2e-3", "output.fields=[a, b, c]", "dem.contact.stiffness=1e6",
+                            "time.steps = 10"});
+  CaseNode root = c.root();
+  CaseNode time = root.child("time");
+  EXPECT_DOUBLE_EQ(time.number("end", Range::positive(), "s"), 2e-3);
+  EXPECT_EQ(time.integer("steps", Range::at_least(1)), 10);
+  EXPECT_EQ(root.child("output").strings("fields"), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_DOUBLE_EQ(root.child("dem").child("contact").number("stiffness", Range::positive(), "N/m"), 1e6);
+}
+
+TEST_F(CaseFileTest, MalformedOverridesAreNamed) {
+  const fs::path file = write(kCase);
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time.end"}); }),
+                  "--set time.end: expected --set key.path=value");
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"=3"}); }), "--set =3: empty key");
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time..end=3"}); }), "--set time..end=3: empty key");
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time.end.x=3"}); }),
+                  "--set time.end.x=3: 'time.end' is 1e-3, not a mapping");
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time.end=[1"}); }),
+                  "--set time.end=[1: YAML syntax error in value");
+}
+
+TEST_F(CaseFileTest, OverriddenValuesReportTheOverride) {
+  CaseFile c = load(kCase, {"dem.sample.radius=-1", "dem.extra.sampel=2"});
+  CaseNode dem = c.root().child("dem");
+  EXPECT_CONTAINS(error_of([&] { dem.child("sample").number("radius", Range::positive(), "m"); }),
+                  "--set dem.sample.radius=-1: dem.sample.radius: expected a number > 0 [m], got -1");
+  CaseNode extra = dem.child("extra");
+  extra.number_or("sample", 1, Range::any(), "1");
+  EXPECT_CONTAINS(error_of([&] { extra.finish(); }),
+                  "--set dem.extra.sampel=2: dem.extra.sampel: unknown key; did you mean 'sample'?");
+  EXPECT_EQ(extra.where(), "--set dem.extra.sampel=2");  // the override created this mapping
+  EXPECT_CONTAINS(dem.child("sample").where(), "case.yaml:5");
+}
+
+TEST_F(CaseFileTest, ListItemsHavePathsAndLines) {
+  CaseFile c = load("loads:\n  - group: top\n    value: 1\n  - group: bottom\n    value: x\n");
+  CaseNode root = c.root();
+  auto loads = root.list("loads");
+  ASSERT_EQ(loads.size(), 2u);
+  EXPECT_EQ(loads[1].path(), "loads[1]");
+  EXPECT_EQ(loads[0].string("group"), "top");
+  EXPECT_CONTAINS(error_of([&] { loads[1].number("value", Range::any(), "N"); }),
+                  "case.yaml:5: loads[1].value: expected a number [N], got 'x'");
+  EXPECT_CONTAINS(error_of([&] { loads[1].fail("group", "group 'bottom' is empty"); }),
+                  "case.yaml:4: loads[1].group: group 'bottom' is empty");
+  EXPECT_TRUE(root.list_or_empty("fixes").empty());
+  EXPECT_CONTAINS(c.resolved_yaml(), "fixes: []");
+}
+
+TEST_F(CaseFileTest, UserNamedChildren) {
+  CaseFile c = load("materials:\n  fibre:\n    young: 1e9\n  matrix:\n    young: 2e9\n");
+  CaseNode materials = c.root().child("materials");
+  for (const auto& name : materials.keys()) {
+    CaseNode m = materials.child_named(name);
+    EXPECT_GT(m.number("young", Range::positive(), "Pa"), 0);
+    m.finish();
+  }
+  materials.finish();
+  CaseFile d = load("materials:\n  fibre: {}\n  glass: {}\n");
+  CaseNode all = d.root().child("materials");
+  all.child_named("fibre");
+  EXPECT_CONTAINS(error_of([&] { all.finish(); }), "materials.glass: unknown key; no keys are expected here");
+  all.accept_any_keys();
+  all.finish();
+}
+
+TEST_F(CaseFileTest, ExistingFileIsRelativeToCaseFolder) {
+  write("Point(1) = {0, 0, 0};\n", "cases/meshes/x.geo");
+  const fs::path file = write("mesh: meshes/x.geo\nother: meshes/y.geo\n", "cases/case.yaml");
+  CaseNode root = CaseFile::load(file).root();
+  EXPECT_EQ(root.existing_file("mesh"), dir_ / "cases/meshes/x.geo");
+  EXPECT_CONTAINS(error_of([&] { root.existing_file("other"); }),
+                  "case.yaml:2: other: file 'meshes/y.geo' not found (looked in " +
+                      (dir_ / "cases/meshes").string() + ")");
+}
+
+TEST_F(CaseFileTest, RangesAndEditDistance) {
+  EXPECT_EQ(Range::positive().describe(), "> 0");
+  EXPECT_EQ(Range::between(0, 1).describe(), "in [0, 1]");
+  EXPECT_EQ(Range::open_between(0, 0.5).describe(), "in (0, 0.5)");
+  EXPECT_EQ(Range::any().describe(), "");
+  EXPECT_FALSE(Range::positive().contains(0));
+  EXPECT_TRUE(Range::non_negative().contains(0));
+  EXPECT_FALSE(Range::open_between(0, 1).contains(1));
+  EXPECT_EQ(edit_distance("sampel", "sample"), 2u);
+  EXPECT_EQ(edit_distance("", "abc"), 3u);
+  EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
+}
+
+}  // namespace
+}  // namespace arlequin

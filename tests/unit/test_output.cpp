@@ -1,0 +1,245 @@
+// Output writers: atomic files, CSV series, JSON summaries and HDF5/XDMF fields.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/atomic_file.hpp"
+#include "common/csv_series.hpp"
+#include "common/error.hpp"
+#include "common/fields_writer.hpp"
+#include "common/json.hpp"
+
+namespace arlequin {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh directory per test, removed afterwards.
+class OutputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("arlequin_output_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+TEST_F(OutputTest, AtomicWriteReplacesContentAndLeavesNoTemporary) {
+  const fs::path path = dir_ / "sub" / "file.txt";
+  write_file_atomically(path, "first version, rather long\n");
+  write_file_atomically(path, "second\n");
+  EXPECT_EQ(read_text(path), "second\n");
+  EXPECT_EQ(temporary_path_for(path), dir_ / "sub" / "file.txt.tmp");
+  EXPECT_FALSE(fs::exists(temporary_path_for(path)));
+  EXPECT_THROW(write_file_atomically(path / "below_a_file", "x"), RunError);
+}
+
+TEST_F(OutputTest, CsvSeriesRoundTrip) {
+  const fs::path path = dir_ / "series.csv";
+  {
+    CsvSeries series(path, {"time", "energy", "count"});
+    const double first[] = {0.0, 1.0 / 3.0, 7.0};
+    const double second[] = {1e-3, -123456.789012345, 1e300};
+    series.append(first);
+    series.append(second);
+    const double wrong[] = {1.0, 2.0};
+    EXPECT_THROW(series.append(wrong), std::logic_error);
+    ASSERT_EQ(series.rows(), 2u);
+    EXPECT_EQ(series.row(1)[1], -123456.789012345);
+    EXPECT_EQ(series.columns().size(), 3u);
+    series.flush();
+    EXPECT_EQ(read_text(path), "time,energy,count\n0,0.333333333333,7\n0.001,-123456.789012,1e+300\n");
+    const double third[] = {2e-3, 0.5, 8.0};
+    series.append(third);
+  }  // the destructor writes the last row
+  EXPECT_EQ(read_text(path),
+            "time,energy,count\n0,0.333333333333,7\n0.001,-123456.789012,1e+300\n0.002,0.5,8\n");
+  EXPECT_FALSE(fs::exists(temporary_path_for(path)));
+}
+
+TEST_F(OutputTest, JsonDumpParseRoundTrip) {
+  Json summary = Json::object();
+  summary["name"] = "quote \" backslash \\ newline \n tab \t bell \x07 é";
+  summary["steps"] = std::size_t{1000};
+  summary["big"] = std::int64_t{-9007199254740993};
+  summary["ratio"] = 0.1;
+  summary["whole"] = 3.0;
+  summary["nan"] = std::nan("");
+  summary["inf"] = std::numeric_limits<double>::infinity();
+  summary["ok"] = true;
+  summary["nothing"] = Json();
+  summary["nested"]["deeper"]["value"] = 42;
+  summary["list"].push_back(1);
+  summary["list"].push_back("two");
+  summary["list"].push_back(Json::array());
+  summary["list"].push_back(Json::object());
+
+  const std::string text = summary.dump();
+  EXPECT_NE(text.find(R"("name": "quote \" backslash \\ newline \n tab \t bell \u0007 é")"), std::string::npos);
+  EXPECT_NE(text.find("\"whole\": 3.0"), std::string::npos);
+  EXPECT_NE(text.find("\"nan\": null"), std::string::npos);
+  EXPECT_LT(text.find("\"name\""), text.find("\"steps\""));  // insertion order kept
+
+  const Json back = Json::parse(text);
+  EXPECT_EQ(back.at("name").as_string(), summary.at("name").as_string());
+  EXPECT_EQ(back.at("steps").type(), Json::Type::Integer);
+  EXPECT_EQ(back.at("steps").as_integer(), 1000);
+  EXPECT_EQ(back.at("big").as_integer(), -9007199254740993);
+  EXPECT_EQ(back.at("ratio").type(), Json::Type::Number);
+  EXPECT_EQ(back.at("ratio").as_number(), 0.1);
+  EXPECT_EQ(back.at("whole").type(), Json::Type::Number);
+  EXPECT_TRUE(back.at("nan").is_null());
+  EXPECT_TRUE(back.at("inf").is_null());
+  EXPECT_EQ(back.at("nested").at("deeper").at("value").as_integer(), 42);
+  EXPECT_EQ(back.at("list").as_array().size(), 4u);
+  EXPECT_EQ(back.at("list").as_array()[1].as_string(), "two");
+  EXPECT_THROW(back.at("ok").as_number(), InputError);
+  EXPECT_THROW(back.at("missing"), InputError);
+
+  // Everything but the non-finite numbers survives exactly, compact or indented.
+  summary["nan"] = Json();
+  summary["inf"] = Json();
+  EXPECT_EQ(back, summary);
+  EXPECT_EQ(Json::parse(summary.dump(-1)), summary);
+  EXPECT_EQ(summary.dump(-1).find('\n'), std::string::npos);
+
+  EXPECT_EQ(Json::parse(R"("\u00e9\ud83d\ude00\/")").as_string(), "\u00e9\U0001F600/");
+  EXPECT_EQ(Json::parse(" -1.5e3 ").as_number(), -1500.0);
+  EXPECT_EQ(Json::parse("123456789012345678901").type(), Json::Type::Number);
+  for (const char* bad : {"", "{", "[1,]", "{\"a\" 1}", "01", "tru", "\"\\x\"", "1 2", "{\"a\":1,\"a\":2}", "\"\n\""}) {
+    EXPECT_THROW(Json::parse(bad), InputError) << bad;
+  }
+  try {
+    Json::parse("[1, 2, x]");
+    FAIL() << "no exception";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("offset 7"), std::string::npos) << e.what();
+  }
+
+  write_json_atomically(dir_ / "summary.json", summary);
+  EXPECT_EQ(Json::parse(read_text(dir_ / "summary.json")), summary);
+}
+
+template <class T>
+std::vector<T> read_dataset(hid_t file, const std::string& path, hid_t type, std::vector<hsize_t> expected_dims) {
+  const hid_t dataset = H5Dopen2(file, path.c_str(), H5P_DEFAULT);
+  EXPECT_GE(dataset, 0) << path;
+  const hid_t space = H5Dget_space(dataset);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)));
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  EXPECT_EQ(dims, expected_dims) << path;
+  std::vector<T> values(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  EXPECT_GE(H5Dread(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0) << path;
+  H5Sclose(space);
+  H5Dclose(dataset);
+  return values;
+}
+
+double read_time(hid_t file, const std::string& frame) {
+  double time = -1.0;
+  const hid_t attribute = H5Aopen_by_name(file, frame.c_str(), "time", H5P_DEFAULT, H5P_DEFAULT);
+  EXPECT_GE(attribute, 0) << frame;
+  EXPECT_GE(H5Aread(attribute, H5T_NATIVE_DOUBLE, &time), 0);
+  H5Aclose(attribute);
+  return time;
+}
+
+TEST_F(OutputTest, FieldsWriterParticlesAndBonds) {
+  const fs::path h5 = dir_ / "out" / "fields.h5";
+  const fs::path xdmf = dir_ / "out" / "fields.xdmf";
+  const std::vector<std::int64_t> bonds = {0, 1, 1, 2};
+  const double times[] = {0.0, 0.25};
+  {
+    FieldsWriter writer(h5, xdmf);
+    for (int f = 0; f < 2; ++f) {
+      const std::vector<Vec3> positions = {{0, 0, 0}, {1.0 + f, 0, 0}, {0, 2, 0.5 * f}};
+      const std::vector<double> radius = {0.1, 0.2, 0.3 + f};
+      const std::vector<Vec3> velocity = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9.0 + f}};
+      const std::vector<std::int32_t> id = {10, 11, 12 + f};
+      const std::vector<double> force = {1.5, -2.5 * f};
+      writer.begin_frame(times[f]);
+      writer.add_grid("particles", positions, FieldsWriter::CellKind::Vertex, {});
+      writer.add_point_field("particles", "radius", std::span<const double>(radius));
+      writer.add_point_field("particles", "velocity", std::span<const Vec3>(velocity));
+      writer.add_point_field("particles", "id", std::span<const std::int32_t>(id));
+      writer.add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, bonds);
+      writer.add_cell_field("bonds", "force", std::span<const double>(force));
+      EXPECT_THROW(writer.add_cell_field("bonds", "bad", std::span<const double>(radius)), std::logic_error);
+      EXPECT_THROW(writer.add_grid("bonds", positions, FieldsWriter::CellKind::Line, bonds), std::logic_error);
+      const std::vector<std::int64_t> out_of_range = {0, 3};
+      EXPECT_THROW(writer.add_grid("broken", positions, FieldsWriter::CellKind::Line, out_of_range), std::logic_error);
+      writer.end_frame();
+      EXPECT_TRUE(fs::exists(fs::path(h5) += ".part"));
+    }
+    EXPECT_THROW(writer.add_grid("late", {}, FieldsWriter::CellKind::Vertex, {}), std::logic_error);
+    EXPECT_EQ(writer.frames(), 2u);
+    writer.close();
+  }
+  EXPECT_FALSE(fs::exists(fs::path(h5) += ".part"));
+  ASSERT_TRUE(fs::exists(h5));
+
+  const hid_t file = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  for (int f = 0; f < 2; ++f) {
+    const std::string frame = f == 0 ? "/frames/000000" : "/frames/000001";
+    EXPECT_EQ(read_time(file, frame), times[f]);
+    const auto points = read_dataset<double>(file, frame + "/particles/points", H5T_NATIVE_DOUBLE, {3, 3});
+    EXPECT_EQ(points, (std::vector<double>{0, 0, 0, 1.0 + f, 0, 0, 0, 2, 0.5 * f}));
+    EXPECT_EQ(read_dataset<std::int64_t>(file, frame + "/particles/connectivity", H5T_NATIVE_INT64, {3}),
+              (std::vector<std::int64_t>{0, 1, 2}));
+    EXPECT_EQ(read_dataset<double>(file, frame + "/particles/point/radius", H5T_NATIVE_DOUBLE, {3}),
+              (std::vector<double>{0.1, 0.2, 0.3 + f}));
+    EXPECT_EQ(read_dataset<double>(file, frame + "/particles/point/velocity", H5T_NATIVE_DOUBLE, {3, 3}),
+              (std::vector<double>{1, 2, 3, 4, 5, 6, 7, 8, 9.0 + f}));
+    EXPECT_EQ(read_dataset<std::int32_t>(file, frame + "/particles/point/id", H5T_NATIVE_INT32, {3}),
+              (std::vector<std::int32_t>{10, 11, 12 + f}));
+    EXPECT_EQ(read_dataset<std::int64_t>(file, frame + "/bonds/connectivity", H5T_NATIVE_INT64, {2, 2}), bonds);
+    EXPECT_EQ(read_dataset<double>(file, frame + "/bonds/cell/force", H5T_NATIVE_DOUBLE, {2}),
+              (std::vector<double>{1.5, -2.5 * f}));
+    EXPECT_EQ(H5Lexists(file, (frame + "/bonds/points").c_str(), H5P_DEFAULT), 0);  // positions stored once
+  }
+
+  const std::string text = read_text(xdmf);
+  EXPECT_NE(text.find("Version=\"3.0\""), std::string::npos);
+  EXPECT_NE(text.find("CollectionType=\"Temporal\""), std::string::npos);
+  EXPECT_NE(text.find("<Grid Name=\"particles\""), std::string::npos);
+  EXPECT_NE(text.find("<Grid Name=\"bonds\""), std::string::npos);
+  EXPECT_NE(text.find("<Time Value=\"0\"/>"), std::string::npos);
+  EXPECT_NE(text.find("<Time Value=\"0.25\"/>"), std::string::npos);
+  EXPECT_NE(text.find("TopologyType=\"Polyline\""), std::string::npos);
+  // Every dataset the XDMF refers to exists in the final file.
+  const std::string prefix = "fields.h5:";
+  std::size_t references = 0;
+  for (std::size_t at = text.find(prefix); at != std::string::npos; at = text.find(prefix, at + 1)) {
+    const std::size_t start = at + prefix.size();
+    const std::string path = text.substr(start, text.find('<', start) - start);
+    EXPECT_GT(H5Oexists_by_name(file, path.c_str(), H5P_DEFAULT), 0) << path;
+    ++references;
+  }
+  // Per frame: particles points + connectivity + 3 fields, bonds shared points + connectivity + 1 field.
+  EXPECT_EQ(references, 2u * 8u);
+  EXPECT_EQ(H5Fclose(file), 0);
+}
+
+}  // namespace
+}  // namespace arlequin
