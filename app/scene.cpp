@@ -40,13 +40,15 @@ void read_sample(CaseNode sample, dem::ParticleSet& p, double density) {
     const double radius = sample.number("radius", Range::positive(), "m");
     const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
     dem::build_chain(p, start, normalized(direction), int(count), spacing, radius, density);
-  } else {
-    for (CaseNode item : sample.list("particles")) {
-      const Vec3 x = item.vec3("position", Range::any(), "m");
-      const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), density);
-      p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
-      item.finish();
-    }
+  }
+  // Explicit DEs (an impactor, a two-body test), after the built ones; the only ones for
+  // build: particles.
+  const auto listed = build == "particles" ? sample.list("particles") : sample.list_or_empty("particles");
+  for (CaseNode item : listed) {
+    const Vec3 x = item.vec3("position", Range::any(), "m");
+    const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), density);
+    p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
+    item.finish();
   }
   sample.finish();
 }

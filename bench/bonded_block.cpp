@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   // ParticleSet; BeamBondSet: two indices, L0, three stiffnesses, two unit vectors).
   using arlequin::Quat;
   using arlequin::Vec3;
-  constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 3 * sizeof(double) + sizeof(arlequin::dem::GroupMask);
+  constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 2 * sizeof(double) + sizeof(arlequin::dem::GroupMask);
   constexpr std::size_t per_bond = 2 * sizeof(std::uint32_t) + 4 * sizeof(double) + 2 * sizeof(Vec3);
   std::printf("layout: %zu B per DE, %zu B per beam bond (targets <= 200, <= 150)\n", per_de, per_bond);
   double one_thread_rate = 0.0;

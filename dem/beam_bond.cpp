@@ -108,7 +108,7 @@ void BeamBondSet::accumulate_forces(ParticleSet& p) const {
 
 double BeamBondSet::energy(const ParticleSet& p) const {
   double e = 0.0;
-#pragma omp parallel for reduction(+ : e) schedule(static)
+#pragma omp parallel for reduction(+ : e) schedule(static) if (size() > parallel_threshold)
   for (long bl = 0; bl < static_cast<long>(size()); ++bl) {
     const auto b = static_cast<std::size_t>(bl);
     const Actions a = actions(b, p);
@@ -132,7 +132,7 @@ void BeamBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> t
       const std::uint32_t i = end == 0 ? first_[b] : second_[b];
       const std::uint32_t j = end == 0 ? second_[b] : first_[b];
       const double mi = p.inv_mass[i], mj = p.inv_mass[j];
-      const double Ii = p.inv_inertia[i], Ij = p.inv_inertia[j];
+      const double Ii = p.inv_inertia(i), Ij = p.inv_inertia(j);
       translational[i] += k_trans * (mi + std::sqrt(mi * mj)) +
                           k_cross * (std::sqrt(mi * Ii) + std::sqrt(mi * Ij));
       rotational[i] += k_rot_own * Ii + k_rot_other * std::sqrt(Ii * Ij) +

@@ -41,12 +41,15 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
   v.swap(sorted);
 }
 
+// Loops shorter than this run on one thread: below it, starting threads costs more than it saves.
+inline constexpr long parallel_threshold = 4096;
+
 // Runs body(b) for every bond, colour by colour, each colour split over threads.
 template <class Body>
 void for_each_bond(const BondColouring& colouring, Body&& body) {
   for (std::size_t c = 0; c + 1 < colouring.offsets.size(); ++c) {
     const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (end - begin > parallel_threshold)
     for (long b = begin; b < end; ++b) body(static_cast<std::size_t>(b));
   }
 }

@@ -8,7 +8,7 @@
 // Kinematic conditions (fixed, velocity, displacement) lock rotations when rotation: fixed
 // (default for fixed, free otherwise). Force sensors report the quasi-static reaction,
 // -(sum of bond and contact forces on the group); the external work of a kinematic condition
-// is the kinetic energy it injects or removes when it overrides velocities.
+// is the work of that reaction plus the change of the driven DEs' kinetic energy.
 #pragma once
 #include <cstdint>
 #include <string>

@@ -69,6 +69,7 @@ void DemModel::finalize() {
       }
     }
   }
+  constraint_reaction_.assign(constraints_.size(), Vec3{});
   for (auto& set : bond_sets_) set->finalize(particles.size());
   if (neighbours_) {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> bonded;
@@ -102,51 +103,52 @@ double DemModel::critical_time_step() const {
 
 void DemModel::step(double dt) {
   last_dt_ = dt;
+  // Work of kinematic conditions = the driven DEs' kinetic energy change (here and at the
+  // end of the step) + the work of their reactions (record_reactions).
+  external_work_ -= driven_kinetic_energy();
   kick(0.5 * dt);                     // v(n+1/2) = v(n) + dt/2 a(n)
   impose_motion(time_, true, dt);     // driven DEs move exactly by u(t+dt) - u(t)
   drift(dt);                          // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
   time_ += dt;
   update_neighbours();                // only with contact, only when a DE moved > skin/2
   compute_forces();                   // bonds, contacts -> f(n+1)
-  record_reactions();                 // reactions of watched groups, for sensors
+  record_reactions();                 // for sensors, and the work of driven DEs
   apply_loads_and_damping();          // dead loads, viscous damping
   kick(0.5 * dt);                     // v(n+1) = v(n+1/2) + dt/2 a(n+1)
   impose_motion(time_, false, dt);    // driven DEs: v = du/dt(t(n+1))
+  external_work_ += driven_kinetic_energy();
   ++steps_;
 }
 
 void DemModel::kick(double half_dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > parallel_threshold)
   for (long i = 0; i < n; ++i) {
     p.velocity[i] += p.force[i] * (half_dt * p.inv_mass[i]);
-    p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia[i]);
+    p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia(i));
   }
 }
 
 void DemModel::impose_motion(double t, bool half_step, double dt) {
-  // The constraint's work is exactly the kinetic energy it adds or removes when it overrides
-  // a velocity (over a step this equals the reaction's work R . dx plus the impulse that
-  // starts or stops a driven DE).
-  ParticleSet& p = particles;
   for (const Constraint& c : constraints_) {
     const BoundaryCondition& bc = boundaries_[c.condition];
-    const std::uint32_t i = c.particle;
-    const Vec3 v = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
-    external_work_ += 0.5 * p.mass(i) * (norm2(v) - norm2(p.velocity[i]));
-    p.velocity[i] = v;
-    if (bc.lock_rotation) {
-      external_work_ -= 0.5 * p.inertia(i) * norm2(p.angular_velocity[i]);
-      p.angular_velocity[i] = {};
-    }
+    particles.velocity[c.particle] =
+        half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+    if (bc.lock_rotation) particles.angular_velocity[c.particle] = {};
   }
+}
+
+double DemModel::driven_kinetic_energy() const {
+  double e = 0.0;
+  for (const Constraint& c : constraints_) e += 0.5 * particles.mass(c.particle) * norm2(particles.velocity[c.particle]);
+  return e;
 }
 
 void DemModel::drift(double dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > parallel_threshold)
   for (long i = 0; i < n; ++i) {
     p.position[i] += p.velocity[i] * dt;
     // Spheres: omega is constant over the drift, so the rotation is exact.
@@ -172,6 +174,14 @@ void DemModel::record_reactions() {
     for (std::size_t i = 0; i < p.size(); ++i) {
       for (GroupMask m = p.groups[i] & watched_; m; m &= m - 1) reaction_[std::countr_zero(m)] -= p.force[i];
     }
+  }
+  // Reaction R = -(bond + contact forces) on each driven DE; over the drift it did the
+  // trapezoidal work (R(n) + R(n+1))/2 . dt v(n+1/2).
+  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+    const std::uint32_t i = constraints_[k].particle;
+    const Vec3 reaction = -p.force[i];
+    external_work_ += dot(0.5 * (reaction + constraint_reaction_[k]), p.velocity[i]) * last_dt_;
+    constraint_reaction_[k] = reaction;
   }
 }
 

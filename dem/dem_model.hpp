@@ -78,6 +78,7 @@ class DemModel {
   void update_neighbours();
   void compute_forces();
   void record_reactions();
+  double driven_kinetic_energy() const;
   void apply_loads_and_damping();
 
   struct Constraint {
@@ -90,6 +91,7 @@ class DemModel {
   std::optional<NeighbourList> neighbours_;
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
+  std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
   std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
   GroupMask watched_ = 0;

@@ -16,7 +16,6 @@ std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
   torque.push_back({});
   radius.push_back(r);
   inv_mass.push_back(1.0 / m);
-  inv_inertia.push_back(1.0 / (0.4 * m * r * r));
   groups.push_back(0);
   return size() - 1;
 }
@@ -36,7 +35,6 @@ void ParticleSet::reserve(std::size_t n) {
   torque.reserve(n);
   radius.reserve(n);
   inv_mass.reserve(n);
-  inv_inertia.reserve(n);
   groups.reserve(n);
 }
 

@@ -1,14 +1,359 @@
 #include "continuum/nem/nem_solver.hpp"
 
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+#include <CGAL/natural_neighbor_coordinates_2.h>
+#include <CGAL/natural_neighbor_coordinates_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <cstdio>
+
 #include "common/error.hpp"
 
 namespace arlequin::continuum {
-struct NemSolver::Geometry {};
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Dt3 = CGAL::Delaunay_triangulation_3<
+    Kernel, CGAL::Triangulation_data_structure_3<CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>,
+                                                 CGAL::Delaunay_triangulation_cell_base_3<Kernel>>>;
+using Dt2 = CGAL::Delaunay_triangulation_2<
+    Kernel, CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>,
+                                                 CGAL::Triangulation_face_base_2<Kernel>>>;
+using Coords = std::vector<std::pair<int, double>>;  // (node, shape function value)
+
+Kernel::Point_3 P3(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+struct Plane {
+  Vec3 n;  // outward unit normal
+  double d;  // n.x = d on the plane, n.x <= d inside
+  Vec3 e1, e2, origin;  // in-plane frame for the 2D triangulation
+  Dt2 dt;  // the plane's own nodes
+  Kernel::Point_2 local(const Vec3& x) const { return {dot(x - origin, e1), dot(x - origin, e2)}; }
+};
+
+// Convex polygon face of a convex polyhedron: outward normal and a tag (>= 0: Delaunay
+// neighbour whose bisector carries it; < 0: domain plane -1 - tag).
+struct Face {
+  std::vector<Vec3> pts;
+  Vec3 n;
+  int tag;
+};
+using Polyhedron = std::vector<Face>;
+
+// Keeps the part of `poly` with n.x <= d (Sutherland-Hodgman per face, plus the cap polygon).
+void clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol) {
+  bool cuts = false;
+  for (const Face& f : poly)
+    for (const Vec3& p : f.pts) cuts = cuts || dot(n, p) - d > tol;
+  if (!cuts) return;
+  Polyhedron out;
+  std::vector<Vec3> cap;
+  for (const Face& f : poly) {
+    Face g{{}, f.n, f.tag};
+    const size_t m = f.pts.size();
+    for (size_t k = 0; k < m; ++k) {
+      const Vec3 &a = f.pts[k], &b = f.pts[(k + 1) % m];
+      const double da = dot(n, a) - d, db = dot(n, b) - d;
+      if (da <= tol) g.pts.push_back(a);
+      if (std::abs(da) <= tol) cap.push_back(a);
+      if ((da < -tol && db > tol) || (da > tol && db < -tol)) {
+        const Vec3 x = a + (da / (da - db)) * (b - a);
+        g.pts.push_back(x);
+        cap.push_back(x);
+      }
+    }
+    if (g.pts.size() >= 3) out.push_back(std::move(g));
+  }
+  if (cap.size() >= 3) {
+    Vec3 c{};
+    for (const Vec3& p : cap) c += p;
+    c = c / static_cast<double>(cap.size());
+    const Vec3 e1 = normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
+    const Vec3 e2 = cross(n, e1);
+    std::sort(cap.begin(), cap.end(), [&](const Vec3& a, const Vec3& b) {
+      return std::atan2(dot(a - c, e2), dot(a - c, e1)) < std::atan2(dot(b - c, e2), dot(b - c, e1));
+    });
+    out.push_back({std::move(cap), n, tag});
+  }
+  poly = std::move(out);
+}
+
+// Laplace (non-Sibsonian) coordinates in 2D: lambda_v = |Voronoi edge between p and v| / |p - v|
+// (Belikov et al. 1997; Sukumar, Moran, Semenov & Belikov, IJNME 50 (2001)). The edge joins the
+// circumcentres of (p, a, b) over the two conflict-boundary edges through v.
+bool laplace_2(const Dt2& dt, const Kernel::Point_2& p, Coords& out) {
+  Dt2::Locate_type lt;
+  int li;
+  const Dt2::Face_handle f = dt.locate(p, lt, li);
+  if (lt == Dt2::VERTEX) {
+    out.push_back({f->vertex(li)->info(), 1.0});
+    return true;
+  }
+  if (lt == Dt2::OUTSIDE_CONVEX_HULL || lt == Dt2::OUTSIDE_AFFINE_HULL) return false;
+  std::vector<Dt2::Edge> hole;
+  dt.get_boundary_of_conflicts(p, std::back_inserter(hole), f);
+  std::map<Dt2::Vertex_handle, std::vector<Kernel::Point_2>> ends;
+  for (const Dt2::Edge& e : hole) {
+    const auto a = e.first->vertex(Dt2::cw(e.second)), b = e.first->vertex(Dt2::ccw(e.second));
+    if (dt.is_infinite(a) || dt.is_infinite(b)) return false;
+    const auto cc = CGAL::circumcenter(p, a->point(), b->point());
+    ends[a].push_back(cc);
+    ends[b].push_back(cc);
+  }
+  double sum = 0;
+  const size_t first = out.size();
+  for (const auto& [v, cc] : ends) {
+    if (cc.size() != 2) return false;
+    const double w = std::sqrt(CGAL::squared_distance(cc[0], cc[1]) / CGAL::squared_distance(p, v->point()));
+    out.push_back({v->info(), w});
+    sum += w;
+  }
+  for (size_t k = first; k < out.size(); ++k) out[k].second /= sum;
+  return true;
+}
+
+}  // namespace
+
+struct NemSolver::Geometry {
+  bool laplace = false;
+  double tol = 0;  // length: "on a plane" for nodes and points
+  Dt3 dt;
+  std::vector<Plane> planes;
+  const std::vector<Vec3>* x = nullptr;
+
+  // Natural-neighbour coordinates on domain plane k (p projected onto it).
+  bool on_plane(int k, const Vec3& p, Coords& out) const {
+    const Plane& pl = planes[k];
+    const Kernel::Point_2 q = pl.local(p);
+    if (laplace) return laplace_2(pl.dt, q, out);
+    struct Info {
+      std::pair<int, double> operator()(const std::pair<Dt2::Vertex_handle, double>& vp) const {
+        return {vp.first->info(), vp.second};
+      }
+    };
+    const size_t first = out.size();
+    const auto r = CGAL::natural_neighbor_coordinates_2(pl.dt, q, std::back_inserter(out), Info());
+    if (!r.third) return false;
+    for (size_t k2 = first; k2 < out.size(); ++k2) out[k2].second /= r.second;
+    return true;
+  }
+
+  // Shape functions at any point of the closed domain; false outside it.
+  bool coords(const Vec3& p, Coords& out) const {
+    out.clear();
+    std::vector<int> on;
+    for (int k = 0; k < static_cast<int>(planes.size()); ++k) {
+      const double s = dot(planes[k].n, p) - planes[k].d;
+      if (s > tol) return false;
+      if (s >= -tol) on.push_back(k);
+    }
+    if (on.size() == 1) return on_plane(on[0], p, out);
+    if (on.size() >= 2) return on_edge_or_corner(on, p, out);
+    std::vector<std::pair<Dt3::Vertex_handle, double>> nn;
+    double norm_coeff = 0;
+    const auto r = laplace ? CGAL::laplace_natural_neighbor_coordinates_3(dt, P3(p), std::back_inserter(nn), norm_coeff)
+                           : CGAL::sibson_natural_neighbor_coordinates_3(dt, P3(p), std::back_inserter(nn), norm_coeff);
+    if (!r.third) return false;
+    for (const auto& [v, c] : nn) out.push_back({v->info(), c / norm_coeff});
+    return true;
+  }
+
+  // On an edge of the domain (two or more planes): the 1D linear interpolant between the
+  // nearest nodes of the edge on either side; at a corner, the corner node.
+  bool on_edge_or_corner(const std::vector<int>& on, const Vec3& p, Coords& out) const {
+    const Vec3 t = cross(planes[on[0]].n, planes[on[1]].n);
+    const auto nearest = dt.nearest_vertex(P3(p));
+    if (on.size() >= 3 || norm(t) < 1e-12) {
+      if (norm((*x)[nearest->info()] - p) > tol) return false;
+      out.push_back({nearest->info(), 1.0});
+      return true;
+    }
+    const Vec3 dir = normalized(t);
+    int lo = -1, hi = -1;
+    double slo = -1e300, shi = 1e300;
+    for (int i = 0; i < static_cast<int>(x->size()); ++i) {
+      const Vec3& xi = (*x)[i];
+      if (std::abs(dot(planes[on[0]].n, xi) - planes[on[0]].d) > tol || std::abs(dot(planes[on[1]].n, xi) - planes[on[1]].d) > tol)
+        continue;
+      const double s = dot(xi - p, dir);
+      if (s <= 0 && s > slo) slo = s, lo = i;
+      if (s >= 0 && s < shi) shi = s, hi = i;
+    }
+    if (lo < 0 || hi < 0) return false;
+    if (lo == hi || shi - slo <= tol) {
+      out.push_back({lo, 1.0});
+      return true;
+    }
+    out.push_back({lo, shi / (shi - slo)});
+    out.push_back({hi, -slo / (shi - slo)});
+    return true;
+  }
+};
+
 std::unique_ptr<ContinuumSolver> NemSolver::create(const ContinuumSettings& settings) {
   return std::make_unique<NemSolver>(settings);
 }
-NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settings) { throw InputError("nem: TODO"); }
+
 NemSolver::~NemSolver() = default;
-InterpolationOperator NemSolver::interpolation(const std::vector<Vec3>&) const { return {}; }
-std::vector<double> NemSolver::weighted_lumped_mass(const ScalarFunction&) const { return {}; }
+
+NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settings), geo_(std::make_unique<Geometry>()) {
+  if (settings.shape_functions != "sibson" && settings.shape_functions != "laplace")
+    throw InputError("nem: shape_functions must be 'sibson' or 'laplace', got '" + settings.shape_functions + "'");
+  Geometry& g = *geo_;
+  g.laplace = settings.shape_functions == "laplace";
+  const std::vector<Vec3>& X = nodes();
+  const int n = num_nodes();
+  g.x = &X;
+  Vec3 lo = X[0], hi = X[0];
+  for (const Vec3& p : X)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
+  const double L = norm(hi - lo);
+  g.tol = 1e-9 * L;
+
+  // Domain planes: the distinct planes of the boundary triangles.
+  for (const auto& tri : mesh_.boundary_triangles()) {
+    const Vec3 nn = normalized(cross(X[tri[1]] - X[tri[0]], X[tri[2]] - X[tri[0]]));
+    const double d = dot(nn, X[tri[0]]);
+    const bool known = std::any_of(g.planes.begin(), g.planes.end(),
+                                   [&](const Plane& p) { return norm(p.n - nn) < 1e-9 && std::abs(p.d - d) < g.tol; });
+    if (!known) {
+      Plane p;
+      p.n = nn;
+      p.d = d;
+      g.planes.push_back(std::move(p));
+    }
+  }
+  for (Plane& p : g.planes) {
+    p.e1 = normalized(std::abs(p.n.x) < 0.9 ? cross(p.n, Vec3{1, 0, 0}) : cross(p.n, Vec3{0, 1, 0}));
+    p.e2 = cross(p.n, p.e1);
+    p.origin = p.d * p.n;
+    std::vector<std::pair<Kernel::Point_2, int>> pts;
+    for (int i = 0; i < n; ++i) {
+      const double s = dot(p.n, X[i]) - p.d;
+      if (s > g.tol)
+        throw InputError("nem: the domain is not convex (node " + std::to_string(i) +
+                         " lies outside the plane of a boundary face); only convex domains are supported");
+      if (s >= -g.tol) pts.push_back({p.local(X[i]), i});
+    }
+    p.dt.insert(pts.begin(), pts.end());
+  }
+  {
+    std::vector<std::pair<Kernel::Point_3, int>> pts;
+    for (int i = 0; i < n; ++i) pts.push_back({P3(X[i]), i});
+    g.dt.insert(pts.begin(), pts.end());
+    { int flat=0, tot=0; for (auto c = g.dt.finite_cells_begin(); c != g.dt.finite_cells_end(); ++c) { ++tot; if (std::abs(CGAL::volume(c->vertex(0)->point(),c->vertex(1)->point(),c->vertex(2)->point(),c->vertex(3)->point())) < 1e-12*L*L*L) ++flat; } std::printf("cells %d flat %d\n", tot, flat); }
+    if (static_cast<int>(g.dt.number_of_vertices()) != n) throw InputError("nem: duplicate nodes in the mesh");
+  }
+
+  // The domain as a polyhedron: its bounding box clipped by every domain plane.
+  Polyhedron domain;
+  {
+    const Vec3 a = lo - 0.01 * L * Vec3{1, 1, 1}, b = hi + 0.01 * L * Vec3{1, 1, 1};
+    auto V = [&](int i, int j, int k) { return Vec3{i ? b.x : a.x, j ? b.y : a.y, k ? b.z : a.z}; };
+    domain = {{{V(0, 0, 0), V(0, 1, 0), V(0, 1, 1), V(0, 0, 1)}, {-1, 0, 0}, -1000000},
+              {{V(1, 0, 0), V(1, 0, 1), V(1, 1, 1), V(1, 1, 0)}, {1, 0, 0}, -1000000},
+              {{V(0, 0, 0), V(0, 0, 1), V(1, 0, 1), V(1, 0, 0)}, {0, -1, 0}, -1000000},
+              {{V(0, 1, 0), V(1, 1, 0), V(1, 1, 1), V(0, 1, 1)}, {0, 1, 0}, -1000000},
+              {{V(0, 0, 0), V(1, 0, 0), V(1, 1, 0), V(0, 1, 0)}, {0, 0, -1}, -1000000},
+              {{V(0, 0, 1), V(0, 1, 1), V(1, 1, 1), V(1, 0, 1)}, {0, 0, 1}, -1000000}};
+    for (int k = 0; k < static_cast<int>(g.planes.size()); ++k) clip(domain, g.planes[k].n, g.planes[k].d, -1 - k, 1e-12 * L);
+    for (const Face& f : domain)
+      if (f.tag == -1000000) throw InputError("nem: the mesh boundary does not close a convex domain");
+  }
+
+  // SCNI: per node the clipped Voronoi cell; flux of the shape functions through its faces.
+  std::vector<std::vector<std::pair<int, Vec3>>> flux(n);
+  cell_volume_.assign(n, 0.0);
+  std::vector<Dt3::Vertex_handle> vh(n);
+  for (auto v = g.dt.finite_vertices_begin(); v != g.dt.finite_vertices_end(); ++v) vh[v->info()] = v;
+  Coords phi;
+  std::vector<Dt3::Vertex_handle> adj;
+  for (int i = 0; i < n; ++i) {
+    Polyhedron cell = domain;
+    adj.clear();
+    g.dt.finite_adjacent_vertices(vh[i], std::back_inserter(adj));
+    for (const auto& v : adj) {
+      const int j = v->info();
+      const Vec3 nn = normalized(X[j] - X[i]);
+      clip(cell, nn, dot(nn, 0.5 * (X[i] + X[j])), j, 1e-12 * L);
+    }
+    for (const Face& f : cell) {
+      if (f.tag >= 0 && f.tag < i) continue;  // shared face, already integrated from cell f.tag
+      Vec3 c{};
+      for (const Vec3& p : f.pts) c += p;
+      c = c / static_cast<double>(f.pts.size());
+      for (size_t k = 0; k < f.pts.size(); ++k) {
+        const Vec3 &a = f.pts[k], &b = f.pts[(k + 1) % f.pts.size()];
+        const double area = 0.5 * norm(cross(a - c, b - c));
+        if (area <= 0) continue;
+        const Vec3 q = (a + b + c) / 3.0;
+        const bool ok = f.tag >= 0 ? g.coords(q, phi) : (phi.clear(), g.on_plane(-1 - f.tag, q, phi));
+        if (!ok) throw RunError("nem: natural-neighbour coordinates failed on a Voronoi face of node " + std::to_string(i));
+        { Vec3 r{}; double su=0; for (const auto& [J, value] : phi) r += value * X[J], su += value;
+          if (norm(r - q) > 1e-12) { static int cnt=0; if (cnt++<8) { std::printf("bad q=(%g,%g,%g) tag=%d err=%g su=%g n=%zu:", q.x,q.y,q.z,f.tag,norm(r-q),su,phi.size()); for (auto& [J,v]:phi) std::printf(" %d:%g(%g,%g,%g)",J,v,X[J].x,X[J].y,X[J].z); std::printf("\n");} } }
+        const Vec3 an = area * f.n;
+        for (const auto& [J, value] : phi) flux[i].push_back({J, value * an});
+        cell_volume_[i] += dot(q - X[i], an) / 3.0;
+        if (f.tag >= 0) {
+          for (const auto& [J, value] : phi) flux[f.tag].push_back({J, -value * an});
+          cell_volume_[f.tag] -= dot(q - X[f.tag], an) / 3.0;
+        }
+      }
+    }
+  }
+
+  // Node materials: that of the first tetrahedron holding the node.
+  std::vector<int> node_material(n, -1);
+  for (int e = 0; e < mesh_.num_tets(); ++e)
+    for (int a = 0; a < mesh_.nodes_per_tet(); ++a)
+      if (node_material[mesh_.tet(e)[a]] < 0) node_material[mesh_.tet(e)[a]] = tet_material_[e];
+  node_density_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    if (!(cell_volume_[i] > 0)) throw RunError("nem: empty Voronoi cell at node " + std::to_string(i));
+    auto& fl = flux[i];
+    std::sort(fl.begin(), fl.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    points_.x.push_back(X[i]);
+    points_.volume.push_back(cell_volume_[i]);
+    points_.material.push_back(node_material[i]);
+    node_density_[i] = materials_[node_material[i]].density;
+    for (size_t k = 0; k < fl.size();) {
+      Vec3 sum{};
+      const int J = fl[k].first;
+      for (; k < fl.size() && fl[k].first == J; ++k) sum += fl[k].second;
+      points_.node.push_back(J);
+      points_.grad.push_back(sum / cell_volume_[i]);
+    }
+    points_.offset.push_back(static_cast<int>(points_.node.size()));
+    std::vector<std::pair<int, Vec3>>().swap(fl);
+  }
+  finish_setup();
+}
+
+InterpolationOperator NemSolver::interpolation(const std::vector<Vec3>& points) const {
+  std::vector<Eigen::Triplet<double>> trip;
+  Coords phi;
+  for (size_t p = 0; p < points.size(); ++p) {
+    if (!geo_->coords(points[p], phi))
+      throw InputError("interpolation point (" + std::to_string(points[p].x) + ", " + std::to_string(points[p].y) + ", " +
+                       std::to_string(points[p].z) + ") lies outside the natural-neighbour domain");
+    for (const auto& [J, value] : phi) trip.emplace_back(static_cast<int>(p), J, value);
+  }
+  InterpolationOperator op(static_cast<int>(points.size()), num_nodes());
+  op.setFromTriplets(trip.begin(), trip.end());
+  return op;
+}
+
+std::vector<double> NemSolver::weighted_lumped_mass(const ScalarFunction& alpha) const {
+  std::vector<double> m(num_nodes());
+  for (int i = 0; i < num_nodes(); ++i) m[i] = alpha(nodes()[i]) * node_density_[i] * cell_volume_[i];
+  return m;
+}
+
 }  // namespace arlequin::continuum

@@ -1,0 +1,115 @@
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "continuum/nem/nem_solver.hpp"
+#include "convergence_util.hpp"
+
+using namespace arlequin;
+using namespace arlequin::continuum;
+using namespace arlequin::continuum::testing;
+
+namespace {
+
+std::unique_ptr<NemSolver> make_nem(double size, const std::string& shape) {
+  ContinuumSettings s = settings("unit_cube.geo", size, 1, Material::isotropic(1e3, 0.3, 1.0));
+  s.shape_functions = shape;
+  return std::make_unique<NemSolver>(s);
+}
+
+}  // namespace
+
+TEST(ContinuumNem, ConsistencyOfShapeFunctionsAndCells) {
+  for (const std::string shape : {"sibson", "laplace"}) {
+    auto s = make_nem(0.25, shape);
+    // Points: random interior ones, points on faces and edges, and the nodes themselves.
+    std::vector<Vec3> pts;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> uni(0, 1);
+    for (int i = 0; i < 300; ++i) pts.push_back({uni(rng), uni(rng), uni(rng)});
+    for (int i = 0; i < 30; ++i) pts.push_back({1.0, uni(rng), uni(rng)});
+    for (int i = 0; i < 10; ++i) pts.push_back({uni(rng), 0.0, 1.0});
+    const size_t first_node = pts.size();
+    pts.insert(pts.end(), s->nodes().begin(), s->nodes().end());
+    const InterpolationOperator N = s->interpolation(pts);
+    for (size_t p = 0; p < pts.size(); ++p) {
+      double sum = 0;
+      Vec3 x{};
+      for (InterpolationOperator::InnerIterator it(N, p); it; ++it) {
+        sum += it.value();
+        x += it.value() * s->nodes()[it.col()];
+        if (p >= first_node) EXPECT_NEAR(it.value(), it.col() == static_cast<int>(p - first_node) ? 1.0 : 0.0, 1e-12);
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-12) << shape << " point " << p;
+      EXPECT_LT(norm(x - pts[p]), 1e-12) << shape << " point " << p;
+    }
+    // Smoothed gradient of u = x is the identity at every node: load u = x and read the strain
+    // (eps_xx = eps_yy = eps_zz = 1, shears 0) ...
+    for (int n = 0; n < s->num_nodes(); ++n)
+      for (int c = 0; c < 3; ++c) s->displacement()[3 * n + c] = s->nodes()[n][c];
+    for (const Voigt& e : s->point_strain()) {
+      EXPECT_NEAR(e[0], 1.0, 1e-12);
+      EXPECT_NEAR(e[1], 1.0, 1e-12);
+      EXPECT_NEAR(e[2], 1.0, 1e-12);
+      EXPECT_NEAR(e.tail<3>().norm(), 0.0, 1e-12);
+    }
+    // ... and with u = (y, z, x) the off-diagonal parts (eps_xy = du_x/dy + du_y/dx = 1, ...).
+    for (int n = 0; n < s->num_nodes(); ++n) {
+      const Vec3& x = s->nodes()[n];
+      s->displacement()[3 * n] = x.y, s->displacement()[3 * n + 1] = x.z, s->displacement()[3 * n + 2] = x.x;
+    }
+    for (const Voigt& e : s->point_strain()) {
+      EXPECT_NEAR(e.head<3>().norm(), 0.0, 1e-12);
+      EXPECT_NEAR(e[3], 1.0, 1e-12);
+      EXPECT_NEAR(e[4], 1.0, 1e-12);
+      EXPECT_NEAR(e[5], 1.0, 1e-12);
+    }
+    double v = 0;
+    for (double vi : s->cell_volumes()) v += vi;
+    EXPECT_NEAR(v, 1.0, 1e-12) << shape;
+  }
+}
+
+TEST(ContinuumNem, PatchTest) {
+  for (const std::string shape : {"sibson", "laplace"}) {
+    auto s = make_nem(0.3, shape);
+    const Material mat = Material::isotropic(1e3, 0.3, 1.0);
+    s->fix("boundary", {true, true, true}, [](const Vec3& x, double) { return affine(x); });
+    s->solve_static("-ksp_type preonly -pc_type lu");
+    double err = 0;
+    for (int n = 0; n < s->num_nodes(); ++n) {
+      const Vec3 e = affine(s->nodes()[n]);
+      for (int c = 0; c < 3; ++c) err = std::max(err, std::abs(s->displacement()[3 * n + c] - e[c]));
+    }
+    EXPECT_LT(err, 1e-10 * 3e-3) << shape;
+    const Voigt sigma = mat.C * affine_strain();
+    double serr = 0;
+    for (const Voigt& st : s->point_stress()) serr = std::max(serr, (st - sigma).norm() / sigma.norm());
+    EXPECT_LT(serr, 1e-10) << shape;
+  }
+}
+
+TEST(ContinuumNem, LumpedMassAndStableExplicitSteps) {
+  auto s = make_nem(0.3, "sibson");
+  double m = 0;
+  for (double mi : s->lumped_mass()) m += mi;
+  EXPECT_NEAR(m, 1.0, 1e-12);  // rho |Omega|
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  for (double& v : s->velocity()) v = uni(rng);
+  s->compute_forces();
+  const double dt = 0.9 * s->critical_time_step();
+  const double e0 = s->kinetic_energy() + s->strain_energy();
+  double emax = e0;
+  for (int i = 0; i < 1500; ++i) {
+    s->step(dt);
+    emax = std::max(emax, s->kinetic_energy() + s->strain_energy());
+  }
+  EXPECT_LT(emax / e0, 20.0);
+}
+
+TEST(ContinuumNem, Convergence) {
+  const double rate = convergence_rate("nem", 1, 0.3, 0.15);
+  std::cout << "NEM L2 rate " << rate << "\n";
+  EXPECT_GE(rate, 1.8);
+}

@@ -1,0 +1,161 @@
+// R1 (REFERENCE.md): single beam bond responses against the closed forms of a linear
+// Euler-Bernoulli beam element, to 1e-9 relative. Small displacements (1e-5 of L) keep the
+// geometric non-linearity (O(d^2/L^2)) and the round-off well below that.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "dem/spring_bond.hpp"
+#include "support/dem_fixtures.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+using test::R1Beam;
+
+struct TwoDEs : ::testing::Test {
+  ParticleSet p;
+  BeamBondSet beam{{R1Beam::E, R1Beam::nu, R1Beam::r_mu}};
+  void SetUp() override {
+    p.add({0, 0, 0}, R1Beam::R, 1.0);
+    p.add({R1Beam::L, 0, 0}, R1Beam::R, 1.0);
+    beam.add(0, 1, p);
+    beam.finalize(2);
+  }
+  BeamBondSet::Actions act() const { return beam.actions(0, p); }
+};
+
+void expect_relative(double value, double expected, double tol = 1e-9) {
+  EXPECT_NEAR(value, expected, tol * std::abs(expected)) << "expected " << expected;
+}
+
+TEST_F(TwoDEs, AxialPull) {
+  const double d = 1e-3;
+  p.position[1].x += d;
+  const auto a = act();
+  expect_relative(a.axial_force, 39269.908169872416 * d);  // E S / L
+  expect_relative(a.axial_force, R1Beam::E * R1Beam::S / R1Beam::L * d);
+  expect_relative(-a.force_on_j.x, a.axial_force);
+  EXPECT_NEAR(norm(a.torque_on_i) + norm(a.torque_on_j), 0.0, 1e-12);
+}
+
+TEST_F(TwoDEs, SidewaysWithRotationsLocked) {
+  const double d = 2e-5;
+  p.position[1].y += d;
+  const auto a = act();
+  const double V = 12 * R1Beam::E * R1Beam::I / std::pow(R1Beam::L, 3) * d;  // 7363.11 d
+  const double M = 6 * R1Beam::E * R1Beam::I / std::pow(R1Beam::L, 2) * d;   // 7363.11 d
+  expect_relative(V / d, 7363.107781851077, 1e-9);
+  // The shear force is perpendicular to the (slightly turned) chord; its y part carries V.
+  expect_relative(-dot(a.force_on_j, cross({0, 0, 1}, a.axis)), V);
+  expect_relative(a.torque_on_i.z, M);
+  expect_relative(a.torque_on_j.z, M);
+}
+
+TEST_F(TwoDEs, SidewaysWithEndFreeToRotate) {
+  const double d = 2e-5;
+  p.position[1].y += d;
+  // Turn DE j about z until it carries no moment (the response is linear: two evaluations).
+  const auto moment_at = [&](double psi) {
+    p.orientation[1] = from_rotation_vector({0, 0, psi});
+    return act().torque_on_j.z;
+  };
+  const double m0 = moment_at(0.0), m1 = moment_at(1e-5);
+  const double psi = -m0 * 1e-5 / (m1 - m0);
+  expect_relative(psi, 1.5 * d / R1Beam::L, 1e-8);  // slope of a cantilever tip: 3d/(2L)
+  p.orientation[1] = from_rotation_vector({0, 0, psi});
+  const auto a = act();
+  EXPECT_NEAR(a.torque_on_j.z, 0.0, 1e-9 * std::abs(m0));
+  expect_relative(-dot(a.force_on_j, cross({0, 0, 1}, a.axis)), 1840.7769454627693 * d, 1e-8);  // 3EI/L^3
+}
+
+TEST_F(TwoDEs, RotateOneEnd) {
+  const double t = 1e-6;
+  for (const Vec3 axis : {Vec3{0, 0, 1}, Vec3{0, 1, 0}}) {
+    p.orientation[0] = from_rotation_vector(axis * t);
+    const auto a = act();
+    expect_relative(-dot(a.torque_on_i, axis), 9817.477042468104 * t);  // 4EI/L
+    expect_relative(-dot(a.torque_on_j, axis), 4908.738521234052 * t);  // 2EI/L
+    expect_relative(norm(a.force_on_j), 7363.107781851077 * t);         // 6EI/L^2
+  }
+}
+
+TEST_F(TwoDEs, TwistAboutTheAxis) {
+  const double t = 1e-6;
+  p.orientation[1] = from_rotation_vector({t, 0, 0});
+  const auto a = act();
+  const double GJ_over_L = R1Beam::G * R1Beam::J / R1Beam::L;
+  expect_relative(GJ_over_L, 1887.98, 5e-6);  // R1 table value, 6 digits
+  expect_relative(-a.torque_on_j.x, GJ_over_L * t);
+  expect_relative(a.torque_on_i.x, GJ_over_L * t);
+  EXPECT_NEAR(norm(a.force_on_j), 0.0, 1e-12);
+}
+
+TEST_F(TwoDEs, ForcesAndMomentsBalanceInAnyConfiguration) {
+  p.position[1] = {1.7, 0.6, -0.4};
+  p.orientation[0] = from_rotation_vector({0.2, -0.1, 0.3});
+  p.orientation[1] = from_rotation_vector({-0.3, 0.25, 0.1});
+  const auto a = act();
+  // Moments about DE i: its torque, DE j's torque and the lever of DE j's force.
+  const Vec3 total = a.torque_on_i + a.torque_on_j + cross(p.position[1] - p.position[0], a.force_on_j);
+  EXPECT_LT(norm(total), 1e-9 * (norm(a.torque_on_i) + norm(a.torque_on_j)));
+}
+
+TEST_F(TwoDEs, EnergyIsThePotentialOfTheForces) {
+  // Central difference of the energy against the force, along a mixed direction.
+  p.position[1] = {2.001, 0.0007, -0.0004};
+  p.orientation[0] = from_rotation_vector({1e-4, -2e-4, 3e-4});
+  const Vec3 dir = normalized(Vec3{0.3, -0.8, 0.5});
+  const double h = 1e-7;
+  const Vec3 x = p.position[1];
+  p.position[1] = x + dir * h;
+  const double e_plus = beam.energy(p);
+  p.position[1] = x - dir * h;
+  const double e_minus = beam.energy(p);
+  p.position[1] = x;
+  const double work_rate = dot(act().force_on_j, dir);
+  EXPECT_NEAR(-(e_plus - e_minus) / (2 * h), work_rate, 1e-4 * std::abs(work_rate));
+}
+
+// R1 chain: 10 bonds (20 mm), clamped, 0.01 N sideways at the tip, relaxed with viscous
+// damping: tip deflection P L^3/(3EI) = 5.432489e-3 mm and rotation P L^2/(2EI) =
+// 4.074367e-4 rad to 1e-4 (SI units here: the deflection is in m).
+TEST(BeamChain, ClampedCantileverRelaxesToBeamTheory) {
+  DemModel model;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 11, 2e-3, 1e-3, 7800.0);
+  test::bond_all_touching(model, {1e11, 0.3, 0.5});
+  model.particles.groups[0] = 1;
+  model.particles.groups[10] = 2;
+  model.add_group("clamp");
+  model.add_group("tip");
+  model.add_boundary({"clamp", BoundaryKind::fixed, {}, 0.0, true});
+  model.add_boundary({"tip", BoundaryKind::force, {0, 0.01, 0}, 0.0, false});
+  model.set_damping(400.0);
+  model.finalize();
+  const double dt = 0.3 * model.critical_time_step();
+  while (model.time() < 0.25) model.step(dt);
+  const double deflection = model.particles.position[10].y;
+  const Quat q = model.particles.orientation[10];
+  const double rotation = 2.0 * std::atan2(q.v.z, q.w);
+  expect_relative(deflection, 5.432489e-6, 1e-4);
+  expect_relative(rotation, 4.074367e-4, 1e-4);
+}
+
+TEST(SpringBond, ForceAndEnergyClosedForm) {
+  ParticleSet p;
+  p.add({0, 0, 0}, 1.0, 1.0);
+  p.add({1, 1, 0}, 1.0, 1.0);
+  SpringBondSet spring(250.0);
+  spring.add(0, 1, p);
+  spring.finalize(2);
+  p.position[1] = {1.3, 1.4, 0.0};
+  p.clear_forces();
+  spring.accumulate_forces(p);
+  const double L = std::hypot(1.3, 1.4), L0 = std::sqrt(2.0);
+  expect_relative(norm(p.force[1]), 250.0 * (L - L0));
+  expect_relative(dot(p.force[1], Vec3{1.3, 1.4, 0} / L), -250.0 * (L - L0));
+  expect_relative(spring.energy(p), 0.5 * 250.0 * (L - L0) * (L - L0));
+}
+
+}  // namespace
+}  // namespace arlequin::dem

@@ -1,0 +1,191 @@
+// Verification of the explicit step against closed forms: free flight and spin, a bonded
+// pair's axial frequency, energy drift and momentum conservation of a bonded block, the
+// long-wave speed of a bonded chain, and an elastic head-on contact.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "dem/penalty_contact.hpp"
+#include "support/dem_fixtures.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+constexpr double steel = 7800.0;                      // kg/m^3
+const BeamBondSet::Parameters beam{2e11, 0.3, 0.5};   // Pa, 1, 1
+
+TEST(FreeMotion, FlightAndSpinAreExact) {
+  DemModel model;
+  model.particles.add({0.1, -0.2, 0.3}, 1e-3, steel);
+  const Vec3 v{1.0, -2.0, 0.5}, w{30.0, -20.0, 50.0};
+  model.particles.velocity[0] = v;
+  model.particles.angular_velocity[0] = w;
+  model.finalize();
+  const double dt = 1e-4;
+  for (int n = 0; n < 1000; ++n) model.step(dt);
+  const double t = model.time();
+  const Vec3 x = model.particles.position[0];
+  EXPECT_LT(norm(x - (Vec3{0.1, -0.2, 0.3} + v * t)), 1e-12);
+  // The body axes have turned by w t about w: compare where a body vector points.
+  const Vec3 a{0.3, 0.4, -0.5};
+  const Vec3 exact = rotate(from_rotation_vector(w * t), a);
+  EXPECT_LT(norm(rotate(model.particles.orientation[0], a) - exact), 1e-12);
+  EXPECT_NEAR(norm2(model.particles.orientation[0].v) + std::pow(model.particles.orientation[0].w, 2), 1.0, 1e-15);
+}
+
+TEST(BondedPair, AxialOscillationAtTheClosedFormFrequency) {
+  DemModel model;
+  const double R = 1e-3;
+  model.particles.add({0, 0, 0}, R, steel);
+  model.particles.add({2 * R, 0, 0}, R, steel);
+  test::bond_all_touching(model, beam);
+  model.particles.velocity[0] = {-1e-3, 0, 0};
+  model.particles.velocity[1] = {1e-3, 0, 0};
+  model.finalize();
+  // Two equal masses on a spring k = E S / L0: omega = sqrt(2 k / m).
+  const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+  const double omega = std::sqrt(2.0 * k / model.particles.mass(0));
+  const double dt = 0.02 / omega;
+  // Times where the relative velocity changes sign, linearly interpolated.
+  std::vector<double> crossings;
+  double previous = 2e-3, t_previous = 0.0;
+  while (crossings.size() < 41) {
+    model.step(dt);
+    const double rel = model.particles.velocity[1].x - model.particles.velocity[0].x;
+    if ((rel < 0) != (previous < 0))
+      crossings.push_back(t_previous + dt * previous / (previous - rel));
+    previous = rel;
+    t_previous = model.time();
+  }
+  const double period = (crossings.back() - crossings.front()) / 20.0;
+  EXPECT_NEAR(2 * std::numbers::pi / period, omega, 1e-3 * omega);
+}
+
+// A 4 x 4 x 4 bonded block with random velocities and spins, no boundary conditions.
+struct FreeBlock : ::testing::Test {
+  DemModel model;
+  void SetUp() override {
+    build_lattice(model.particles, {0, 0, 0}, {4, 4, 4}, 2e-3, 1e-3, steel);
+    test::bond_all_touching(model, beam);
+    std::mt19937 rng(42);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (std::size_t i = 0; i < model.particles.size(); ++i) {
+      model.particles.velocity[i] = {1e-2 * u(rng), 1e-2 * u(rng), 1e-2 * u(rng)};
+      model.particles.angular_velocity[i] = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
+    }
+    model.finalize();
+  }
+  Vec3 momentum() const {
+    Vec3 P{};
+    for (std::size_t i = 0; i < model.particles.size(); ++i) P += model.particles.velocity[i] * model.particles.mass(i);
+    return P;
+  }
+  Vec3 angular_momentum() const {
+    Vec3 L{};
+    const ParticleSet& p = model.particles;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      L += cross(p.position[i], p.velocity[i] * p.mass(i)) + p.angular_velocity[i] * p.inertia(i);
+    return L;
+  }
+};
+
+TEST_F(FreeBlock, EnergyDriftBelow1e4Over1e5StepsAtHalfTheCriticalStep) {
+  const double dt = 0.5 * model.critical_time_step();
+  const int steps = 100000, every = 100;
+  std::vector<double> energy;
+  for (int n = 0; n <= steps; ++n) {
+    if (n % every == 0) energy.push_back(model.energies().total());
+    if (n < steps) model.step(dt);
+  }
+  // Drift: mean over the last tenth against the first tenth (the step's bounded
+  // oscillation of the energy is not drift).
+  const std::size_t tenth = energy.size() / 10;
+  double first = 0, last = 0;
+  for (std::size_t k = 0; k < tenth; ++k) first += energy[k], last += energy[energy.size() - 1 - k];
+  EXPECT_LT(std::abs(last - first) / first, 1e-4);
+}
+
+TEST_F(FreeBlock, MomentumIsConservedToRoundOff) {
+  const Vec3 P0 = momentum(), L0 = angular_momentum();
+  double p_scale = 0, l_scale = 0;
+  for (std::size_t i = 0; i < model.particles.size(); ++i) {
+    p_scale += model.particles.mass(i) * norm(model.particles.velocity[i]);
+    l_scale += model.particles.inertia(i) * norm(model.particles.angular_velocity[i]);
+  }
+  const double dt = 0.3 * model.critical_time_step();
+  for (int n = 0; n < 2000; ++n) model.step(dt);
+  EXPECT_LT(norm(momentum() - P0), 1e-12 * p_scale);
+  EXPECT_LT(norm(angular_momentum() - L0), 1e-11 * l_scale);
+}
+
+TEST(BondedChain, PulseTravelsAtTheLongWaveSpeed) {
+  DemModel model;
+  const double R = 1e-3, L0 = 2 * R;
+  const int n = 400, probe = 300;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, n, L0, R, steel);
+  test::bond_all_touching(model, beam);
+  model.particles.groups[0] = 1;
+  model.add_group("driver");
+  const double v0 = 1e-3;
+  model.add_boundary({"driver", BoundaryKind::velocity, {v0, 0, 0}, 0.0, false});
+  model.finalize();
+  const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / L0;
+  const double c = L0 * std::sqrt(k / model.particles.mass(0));  // long-wave speed of the chain
+  const double dt = 0.3 * model.critical_time_step();
+  // Arrival: the probe's velocity reaches half the driven velocity (the centre of the
+  // dispersive front of a step travels at c).
+  double arrival = 0.0, previous = 0.0;
+  while (arrival == 0.0) {
+    model.step(dt);
+    const double v = model.particles.velocity[probe].x;
+    if (v >= 0.5 * v0) arrival = model.time() - dt * (v - 0.5 * v0) / (v - previous);
+    previous = v;
+    ASSERT_LT(model.time(), 10.0 * probe * L0 / c);
+  }
+  const double speed = probe * L0 / arrival;
+  EXPECT_NEAR(speed, c, 0.02 * c);
+}
+
+TEST(PenaltyContact, HeadOnImpactConservesEnergy) {
+  DemModel model;
+  const double R = 1e-3, K = 1e6;
+  model.particles.add({0, 0, 0}, R, steel);
+  model.particles.add({2 * R + 1e-4, 0, 0}, R, steel);
+  model.particles.velocity[0] = {1.0, 0, 0};
+  model.particles.velocity[1] = {-1.0, 0, 0};
+  model.set_contact(std::make_unique<PenaltyContact>(K), 0.2 * R);
+  model.finalize();
+  const double e0 = model.energies().total();
+  // Velocity Verlet's energy error while in contact is bounded, O((omega dt)^2).
+  const double dt = 0.01 * model.critical_time_step();
+  double worst = 0.0, max_contact = 0.0;
+  while (model.time() < 4e-4) {
+    model.step(dt);
+    const Energies e = model.energies();
+    worst = std::max(worst, std::abs(e.total() - e0));
+    max_contact = std::max(max_contact, e.contact);
+  }
+  EXPECT_GT(max_contact, 0.5 * e0);  // the DEs did meet and store most of the energy
+  EXPECT_NEAR(model.particles.velocity[0].x, -1.0, 1e-4);  // they bounced back, elastically
+  EXPECT_NEAR(model.particles.velocity[1].x, 1.0, 1e-4);
+  EXPECT_NEAR(model.energies().total(), e0, 1e-4 * e0);
+  EXPECT_LT(worst, 1e-3 * e0);
+}
+
+TEST(CriticalTimeStep, BoundsTheTrueFrequencyOfABondedPair) {
+  DemModel model;
+  const double R = 1e-3;
+  model.particles.add({0, 0, 0}, R, steel);
+  model.particles.add({2 * R, 0, 0}, R, steel);
+  test::bond_all_touching(model, beam);
+  model.finalize();
+  const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+  const double omega_axial = std::sqrt(2.0 * k / model.particles.mass(0));
+  EXPECT_LE(model.critical_time_step(), 2.0 / omega_axial);
+  // A bound, not a wild one: within a factor of four of the axial mode's limit.
+  EXPECT_GT(model.critical_time_step(), 0.25 * 2.0 / omega_axial);
+}
+
+}  // namespace
+}  // namespace arlequin::dem
