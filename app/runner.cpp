@@ -190,9 +190,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     for (long n = 1; n <= total_steps; ++n) {
       model.step(scene.dt);
       if (n == 1) energy_scale = std::max(energy_scale, model.energies().kinetic);
-      if (n % 50 == 0 || n == total_steps) {
-        model.check_health(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
-      }
+      model.check_finite();
+      if (n % 50 == 0 || n == total_steps)
+        model.check_energy(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
       if (model.time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
       progress.update(n, model.time());
     }

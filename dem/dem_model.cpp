@@ -228,32 +228,39 @@ Vec3 DemModel::mean_displacement(int group) const {
   return count ? sum / static_cast<double>(count) : Vec3{};
 }
 
-void DemModel::check_health(double energy_limit) const {
+void DemModel::check_finite() const {
   const ParticleSet& p = particles;
-  std::size_t worst = 0;
-  double worst_energy = -1.0;
-  double kinetic = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!is_finite(p.position[i]) || !is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
-      std::ostringstream msg;
-      msg << "step " << steps_ << " (t = " << time_ << " s): DE " << i
-          << " has a non-finite position or velocity; likely cause: a time step above the "
-             "stability limit, or an initial overlap far too deep for the contact stiffness";
-      throw RunError(msg.str());
+  std::size_t bad = 0, first = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
+      if (bad++ == 0) first = i;
     }
+  if (bad == 0) return;
+  std::ostringstream msg;
+  msg << "step " << steps_ << " (t = " << time_ << " s): " << bad << " DE(s) have a non-finite velocity, "
+      << "the first is DE " << first << " at (" << p.reference[first].x << ", " << p.reference[first].y << ", "
+      << p.reference[first].z << ") m; likely cause: a time step above the stability limit, or an initial "
+         "overlap far too deep for the contact stiffness";
+  throw RunError(msg.str());
+}
+
+void DemModel::check_energy(double energy_limit) const {
+  const ParticleSet& p = particles;
+  std::size_t fastest = 0;
+  double fastest_energy = -1.0, kinetic = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
     const double e = 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
     kinetic += e;
-    if (e > worst_energy) worst_energy = e, worst = i;
+    if (e > fastest_energy) fastest_energy = e, fastest = i;
   }
-  if (kinetic > energy_limit) {
-    std::ostringstream msg;
-    msg << "step " << steps_ << " (t = " << time_ << " s): kinetic energy " << kinetic
-        << " J exceeds the blow-up limit " << energy_limit << " J (fastest DE: " << worst
-        << " at " << p.position[worst].x << ", " << p.position[worst].y << ", " << p.position[worst].z
-        << "); likely cause: a time step too close to the stability limit for the stiffest "
-           "bond or contact, or energy injected by boundary conditions";
-    throw RunError(msg.str());
-  }
+  if (kinetic <= energy_limit) return;
+  std::ostringstream msg;
+  msg << "step " << steps_ << " (t = " << time_ << " s): kinetic energy " << kinetic
+      << " J exceeds the blow-up limit " << energy_limit << " J (fastest DE: " << fastest << " at ("
+      << p.position[fastest].x << ", " << p.position[fastest].y << ", " << p.position[fastest].z
+      << ") m); likely cause: a time step too close to the stability limit for the stiffest bond or "
+         "contact, or energy injected by boundary conditions";
+  throw RunError(msg.str());
 }
 
 }  // namespace arlequin::dem

@@ -5,7 +5,7 @@
 // then finalize() once (checks boundary conditions, colours bonds, builds the neighbour list
 // only if there is a contact law), then step(). Throws std::invalid_argument from finalize()
 // for contradictory setups (the application adds the case-file location), RunError from
-// check_health() when the run has gone non-finite or blown up.
+// check_finite() / check_energy() when the run has gone non-finite or blown up.
 #pragma once
 #include <memory>
 #include <optional>
@@ -67,9 +67,11 @@ class DemModel {
   // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
   Vec3 reaction_on(int group) const { return reaction_[group]; }
   Vec3 mean_displacement(int group) const;
-  // Throws RunError naming the step, the DE and the likely cause if anything is
-  // non-finite or the kinetic energy exceeds `energy_limit` (J).
-  void check_health(double energy_limit) const;
+  // Both throw RunError naming the step, the DE and the likely cause. check_finite: any
+  // non-finite velocity (cheap, meant for every step); check_energy: kinetic energy above
+  // energy_limit (J), a blow-up.
+  void check_finite() const;
+  void check_energy(double energy_limit) const;
 
  private:
   void kick(double half_dt);

@@ -1,0 +1,119 @@
+// Bad input gets a clear one-line error naming the file, line and key, a non-zero exit and
+// no crash. Each case edits one line of a valid case file (or the command line).
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "support/cli.hpp"
+
+namespace arlequin {
+namespace {
+
+const std::vector<std::string> valid_case = {
+    "name: bad_input",                                                             // 1
+    "time: {end: 1.0e-4, dt: auto}",                                               // 2
+    "dem:",                                                                        // 3
+    "  density: 7800",                                                             // 4
+    "  sample: {build: chain, count: 3, radius: 1.0e-3}",                          // 5
+    "  bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}",                                // 6
+    "groups:",                                                                     // 7
+    "  - {name: left, region: {box: [[-1, -1, -1], [0.0005, 1, 1]]}}",             // 8
+    "  - {name: right, region: {half_space: {point: [0.003, 0, 0], normal: [1, 0, 0]}}}",  // 9
+    "boundary:",                                                                   // 10
+    "  - {group: left, type: fixed}",                                              // 11
+    "  - {group: right, type: velocity, value: [0.1, 0, 0]}",                      // 12
+    "sensors:",                                                                    // 13
+    "  - {name: F, type: force, group: right, component: x}",                      // 14
+    "output: {every: 1.0e-5}",                                                     // 15
+};
+
+struct BadInput {
+  std::string name;
+  int line;                 // line of valid_case to replace (1-based), 0: none
+  std::string replacement;  // new text of that line
+  std::string extra_args;   // appended to the command line
+  std::vector<std::string> expected;  // substrings of the error line
+};
+
+std::ostream& operator<<(std::ostream& os, const BadInput& b) { return os << b.name; }
+
+class BadInputTest : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadInputTest, OneLineErrorNamingWhereAndNonZeroExit) {
+  const BadInput& b = GetParam();
+  const auto dir = test::scratch_dir("bad_" + b.name);
+  const auto file = dir / "case.yaml";
+  {
+    std::ofstream out(file);
+    for (std::size_t k = 0; k < valid_case.size(); ++k)
+      out << (int(k) + 1 == b.line ? b.replacement : valid_case[k]) << "\n";
+  }
+  const auto r = test::run_arlequin("check " + file.string() + " " + b.extra_args);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_EQ(r.output.rfind("arlequin: error: ", 0), 0u) << r.output;
+  for (const auto& s : b.expected) EXPECT_NE(r.output.find(s), std::string::npos) << "missing '" << s << "' in: " << r.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadInputTest,
+    ::testing::Values(
+        BadInput{"unknown_top_key", 15, "outptu: {every: 1.0e-5}", "", {"case.yaml:15", "outptu", "did you mean 'output'"}},
+        BadInput{"unknown_nested_key", 6, "  bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5, tolerence: 0.01}", "",
+                 {"case.yaml:6", "dem.bond.tolerence", "did you mean 'tolerance'"}},
+        BadInput{"wrong_type", 2, "time: {end: abc}", "", {"case.yaml:2", "time.end", "expected a number"}},
+        BadInput{"negative_radius", 5, "  sample: {build: chain, count: 3, radius: -1.0e-3}", "",
+                 {"case.yaml:5", "dem.sample.radius", "> 0"}},
+        BadInput{"unit_suffix", 5, "  sample: {build: chain, count: 3, radius: 1 mm}", "",
+                 {"case.yaml:5", "dem.sample.radius", "no unit suffix"}},
+        BadInput{"dt_above_critical", 2, "time: {end: 1.0e-4, dt: 1.0e-3}", "",
+                 {"case.yaml:2", "time.dt", "critical time step"}},
+        BadInput{"empty_group", 9, "  - {name: right, region: {box: [[5, 5, 5], [6, 6, 6]]}}", "",
+                 {"case.yaml:9", "region", "contains no DE"}},
+        BadInput{"contradictory_boundary", 9, "  - {name: right, region: {box: [[-1, -1, -1], [1, 1, 1]]}}", "",
+                 {"case.yaml:", "boundary", "only one boundary condition"}},
+        BadInput{"unknown_bond_law", 6, "  bond: {law: bem, E_mu: 2.0e11, r_mu: 0.5}", "",
+                 {"case.yaml:6", "dem.bond.law", "did you mean 'beam'"}},
+        BadInput{"yaml_syntax", 5, "  sample: {build: chain, count: 3, radius: [1.0e-3}", "",
+                 {"case.yaml:", "YAML syntax error"}},
+        BadInput{"unknown_group", 11, "  - {group: lefft, type: fixed}", "",
+                 {"case.yaml:11", "boundary[0].group", "unknown group 'lefft'"}},
+        BadInput{"fractional_count", 5, "  sample: {build: chain, count: 2.5, radius: 1.0e-3}", "",
+                 {"case.yaml:5", "dem.sample.count"}},
+        BadInput{"missing_required", 2, "time: {dt: auto}", "", {"case.yaml:2", "time", "missing required key 'end'"}},
+        BadInput{"r_mu_out_of_range", 6, "  bond: {law: beam, E_mu: 2.0e11, r_mu: 5}", "",
+                 {"case.yaml:6", "dem.bond.r_mu"}},
+        BadInput{"unknown_sensor_type", 14, "  - {name: F, type: forse, group: right}", "",
+                 {"case.yaml:14", "sensors[0].type", "did you mean 'force'"}},
+        BadInput{"unknown_output_field", 15, "output: {fields: [particle]}", "",
+                 {"case.yaml:15", "output.fields", "particle"}},
+        BadInput{"duplicate_group", 9, "  - {name: left, region: {box: [[-1, -1, -1], [1, 1, 1]]}}", "",
+                 {"case.yaml:9", "groups[1].name", "defined twice"}},
+        BadInput{"inverted_box", 8, "  - {name: left, region: {box: [[1, 1, 1], [0, 0, 0]]}}", "",
+                 {"case.yaml:8", "box", "lower corner"}},
+        BadInput{"ramp_missing", 12, "  - {group: right, type: displacement, value: [1.0e-6, 0, 0]}", "",
+                 {"case.yaml:12", "boundary[1]", "missing required key 'ramp'"}},
+        BadInput{"negative_density", 4, "  density: -7800", "", {"case.yaml:4", "dem.density"}},
+        BadInput{"duplicate_yaml_key", 4, "  density: 7800\n  density: 1000", "", {"case.yaml:", "density", "duplicate key"}},
+        BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
+        BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
+        BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(BadInput, MissingCaseFile) {
+  const auto r = test::run_arlequin("run /nonexistent/folder/case.yaml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("/nonexistent/folder/case.yaml"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cannot open"), std::string::npos) << r.output;
+}
+
+TEST(BadInput, UnknownCommandSuggestsTheClosest) {
+  const auto r = test::run_arlequin("rnu x.yaml");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("did you mean 'run'"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace arlequin

@@ -1,0 +1,102 @@
+// The cases of cases/ run through the `arlequin` executable, checked against their references.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "app/runner.hpp"
+#include "app/scene.hpp"
+#include "common/error.hpp"
+#include "common/json.hpp"
+#include "support/cli.hpp"
+
+namespace arlequin {
+namespace {
+
+const std::string cases = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/";
+
+Json run_case(const std::string& name, const std::string& extra = "") {
+  const auto out = test::scratch_dir(name);
+  const auto r = test::run_arlequin("run " + cases + name + "/case.yaml --quiet --out " + out.string() + " " + extra);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"series.csv", "summary.json", "case.resolved.yaml"})
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+  EXPECT_FALSE(std::filesystem::exists(out / "series.csv.tmp"));
+  return Json::parse(test::read_text(out / "summary.json"));
+}
+
+double relative_balance(const Json& summary) {
+  const Json& e = summary.at("energies");
+  const double balance = e.at("total").as_number() + e.at("dissipated").as_number() - e.at("external_work").as_number();
+  return balance;
+}
+
+// R1 chain through the case file: tip deflection P L^3 / (3 E I) = 5.432489e-6 m (1e-4).
+TEST(Cases, CantileverChainMatchesBeamTheory) {
+  const Json s = run_case("cantilever_chain");
+  EXPECT_EQ(s.at("status").as_string(), "completed");
+  EXPECT_NEAR(s.at("sensors").at("tip_deflection").as_number(), 5.432489e-6, 5.432489e-10);
+  EXPECT_NEAR(s.at("sensors").at("clamp_reaction").as_number(), -0.01, 1e-8);
+  // Static equilibrium: half the load's work is stored, half was damped out.
+  EXPECT_NEAR(relative_balance(s), 0.0, 1e-4 * s.at("energies").at("external_work").as_number());
+}
+
+TEST(Cases, DemoBeamImpactConservesEnergyAndWritesFields) {
+  const auto out = test::scratch_dir("demo");
+  const auto r = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  const double initial = 0.5 * 8.82e-4 * 400.0;  // ball: m = 7800 * 4/3 pi (3 mm)^3, v = 20 m/s
+  EXPECT_NEAR(s.at("energies").at("total").as_number(), initial, 2e-3 * initial);
+  EXPECT_TRUE(std::filesystem::exists(out / "fields.h5"));
+  EXPECT_TRUE(std::filesystem::exists(out / "fields.xdmf"));
+  EXPECT_FALSE(std::filesystem::exists(out / "fields.h5.part"));
+  EXPECT_GT(s.at("counts").at("neighbour_rebuilds").as_integer(), 0);
+}
+
+TEST(Cases, BondedBlockShortRunBalancesEnergyWithoutContactSearch) {
+  const Json s = run_case("bonded_block_tension", "--steps 50");
+  EXPECT_EQ(s.at("steps").as_integer(), 50);
+  EXPECT_EQ(s.at("counts").at("particles").as_integer(), 20000);
+  EXPECT_EQ(s.at("counts").find("contact_candidates"), nullptr);  // bonded-only: no contact search
+  const double work = s.at("energies").at("external_work").as_number();
+  EXPECT_GT(work, 0.0);
+  EXPECT_NEAR(relative_balance(s), 0.0, 1e-3 * work);
+}
+
+TEST(Cli, VersionHelpAndCheck) {
+  EXPECT_EQ(test::run_arlequin("--version", "stdout").exit_code, 0);
+  EXPECT_NE(test::run_arlequin("run --help", "stdout").output.find("--steps"), std::string::npos);
+  const auto check = test::run_arlequin("check " + cases + "cantilever_chain/case.yaml", "stdout");
+  EXPECT_EQ(check.exit_code, 0);
+  EXPECT_NE(check.output.find("critical time step"), std::string::npos);
+  EXPECT_NE(check.output.find("safety: 0.3"), std::string::npos);  // resolved case with defaults
+  EXPECT_NE(check.output.find("tolerance: 0.01"), std::string::npos);
+}
+
+// A non-finite state stops the run with a message naming the step and the DE, and the
+// outputs written so far stay readable (series.csv rows, summary.json with the failure).
+TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
+  const auto out = test::scratch_dir("nan_stop");
+  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {{}, out});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  app::RunOptions options;
+  options.max_steps = 400;
+  // Poison one DE's velocity: the check after the first step must stop the run.
+  scene.dem.particles.velocity[17] = {nan, 0.0, 0.0};
+  try {
+    app::run_scene(scene, options);
+    FAIL() << "the run should have stopped";
+  } catch (const RunError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("step 1 "), std::string::npos) << msg;
+    EXPECT_NE(msg.find("non-finite velocity"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("likely cause"), std::string::npos) << msg;
+  }
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("status").as_string(), "failed");
+  EXPECT_NE(test::read_text(out / "series.csv").find("time,step"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out / "fields.xdmf"));
+}
+
+}  // namespace
+}  // namespace arlequin
