@@ -524,7 +524,9 @@ std::vector<Vec3> CaseNode::vec3_list(std::string_view key, Range each, std::str
     Vec3 v;
     for (int k = 0; k < 3; ++k) v[k] = to_number(xyz[k], each, unit, false);
     out.push_back(v);
-    texts.push_back("[" + format_number(v.x) + ", " + format_number(v.y) + ", " + format_number(v.z) + "]");
+    std::string text = "[";
+    text.append(format_number(v.x)).append(", ").append(format_number(v.y)).append(", ").append(format_number(v.z)).append("]");
+    texts.push_back(std::move(text));
   }
   record_->put_list(key, Kind::Plain, texts);
   return out;

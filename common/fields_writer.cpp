@@ -299,8 +299,8 @@ std::string FieldsWriter::write_dataset(const std::string& path, const Column& c
   if (column.rows > 0)
     checked(H5Dwrite(dataset, column.type, H5S_ALL, H5S_ALL, H5P_DEFAULT, column.data), part_path_, "write dataset",
             path);
-  const std::string dimensions =
-      std::to_string(column.rows) + (rank == 1 ? "" : " " + std::to_string(column.components));
+  std::string dimensions = std::to_string(column.rows);
+  if (rank != 1) dimensions.append(" ").append(std::to_string(column.components));
   return "<DataItem Dimensions=\"" + dimensions + "\" NumberType=\"" + column.xdmf_type + "\" Precision=\"" +
          std::to_string(column.precision) + "\" Format=\"HDF\">" + h5_reference_ + ":" + xml_escaped(path) +
          "</DataItem>";

@@ -34,18 +34,26 @@ TEST(FreeMotion, FlightAndSpinAreExact) {
   EXPECT_NEAR(norm2(model.particles.orientation[0].v) + std::pow(model.particles.orientation[0].w, 2), 1.0, 1e-15);
 }
 
-TEST(BondedPair, AxialOscillationAtTheClosedFormFrequency) {
+// Two touching DEs of radius R = 1 mm joined by one beam; omega_axial = sqrt(2 k / m) for the
+// two equal masses on the axial spring k = E S / L0.
+struct BondedPair : ::testing::Test {
+  static constexpr double R = 1e-3;
   DemModel model;
-  const double R = 1e-3;
-  model.particles.add({0, 0, 0}, R, steel);
-  model.particles.add({2 * R, 0, 0}, R, steel);
-  test::bond_all_touching(model, beam);
+  double omega_axial = 0.0;
+  void SetUp() override {
+    model.particles.add({0, 0, 0}, R, steel);
+    model.particles.add({2 * R, 0, 0}, R, steel);
+    test::bond_all_touching(model, beam);
+    const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+    omega_axial = std::sqrt(2.0 * k / model.particles.mass(0));
+  }
+};
+
+TEST_F(BondedPair, AxialOscillationAtTheClosedFormFrequency) {
   model.particles.velocity[0] = {-1e-3, 0, 0};
   model.particles.velocity[1] = {1e-3, 0, 0};
   model.finalize();
-  // Two equal masses on a spring k = E S / L0: omega = sqrt(2 k / m).
-  const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
-  const double omega = std::sqrt(2.0 * k / model.particles.mass(0));
+  const double omega = omega_axial;
   const double dt = 0.02 / omega;
   // Times where the relative velocity changes sign, linearly interpolated.
   std::vector<double> crossings;
@@ -173,15 +181,8 @@ TEST(PenaltyContact, HeadOnImpactConservesEnergy) {
   EXPECT_LT(worst, 1e-3 * e0);
 }
 
-TEST(CriticalTimeStep, BoundsTheTrueFrequencyOfABondedPair) {
-  DemModel model;
-  const double R = 1e-3;
-  model.particles.add({0, 0, 0}, R, steel);
-  model.particles.add({2 * R, 0, 0}, R, steel);
-  test::bond_all_touching(model, beam);
+TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
   model.finalize();
-  const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
-  const double omega_axial = std::sqrt(2.0 * k / model.particles.mass(0));
   EXPECT_LE(model.critical_time_step(), 2.0 / omega_axial);
   // A bound, not a wild one: within a factor of four of the axial mode's limit.
   EXPECT_GT(model.critical_time_step(), 0.25 * 2.0 / omega_axial);
