@@ -71,6 +71,14 @@ void BeamBondSet::finalize(std::size_t n_particles) {
   apply_order(normal_, order);
 }
 
+void BeamBondSet::scale_stiffness(std::span<const double> factor) {
+  for (std::size_t b = 0; b < size(); ++b) {
+    axial_[b] *= factor[b];
+    bending_[b] *= factor[b];
+    torsion_[b] *= factor[b];
+  }
+}
+
 BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
   const std::uint32_t i = first_[b], j = second_[b];
   const Quat& qi = p.orientation[i];

@@ -43,6 +43,7 @@ class BeamBondSet final : public BondSet {
   double energy(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
+  void scale_stiffness(std::span<const double> factor) override;
 
   // The generalised forces of bond b in the current configuration (for tests, sensors and
   // failure criteria): forces and torques exerted by the bond on its two DEs.

@@ -68,6 +68,9 @@ class BondSet {
   // lambda_max <= max_i sum_j ||A_ij||_2).
   virtual void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                                     std::span<double> rotational) const = 0;
+  // Multiplies bond b's stiffness (all its modes) by factor[b] (Arlequin weighting): once at
+  // set-up, so the force loop pays nothing for it.
+  virtual void scale_stiffness(std::span<const double> factor) = 0;
 
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }

@@ -102,6 +102,11 @@ double DemModel::critical_time_step() const {
 }
 
 void DemModel::step(double dt) {
+  advance_to_forces(dt);
+  finish_step(dt);
+}
+
+void DemModel::advance_to_forces(double dt) {
   last_dt_ = dt;
   // Work of kinematic conditions = the driven DEs' kinetic energy change (here and at the
   // end of the step) + the work of their reactions (record_reactions).
@@ -114,10 +119,25 @@ void DemModel::step(double dt) {
   compute_forces();                   // bonds, contacts -> f(n+1)
   record_reactions();                 // for sensors, and the work of driven DEs
   apply_loads_and_damping();          // dead loads, viscous damping
+}
+
+void DemModel::finish_step(double dt) {
   kick(0.5 * dt);                     // v(n+1) = v(n+1/2) + dt/2 a(n+1)
   impose_motion(time_, false, dt);    // driven DEs: v = du/dt(t(n+1))
   external_work_ += driven_kinetic_energy();
   ++steps_;
+}
+
+void DemModel::apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor) {
+  ParticleSet& p = particles;
+  for (std::size_t i = 0; i < p.size(); ++i) p.inv_mass[i] /= std::max(alpha(p.position[i]), mass_floor);
+  std::vector<double> factor;
+  for (auto& set : bond_sets_) {
+    factor.resize(set->size());
+    for (std::size_t b = 0; b < set->size(); ++b)
+      factor[b] = alpha(0.5 * (p.position[set->first()[b]] + p.position[set->second()[b]]));
+    set->scale_stiffness(factor);
+  }
 }
 
 void DemModel::kick(double half_dt) {

@@ -7,6 +7,7 @@
 // for contradictory setups (the application adds the case-file location), RunError from
 // check_finite() / check_energy() when the run has gone non-finite or blown up.
 #pragma once
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -50,6 +51,12 @@ class DemModel {
   // Reaction forces of this group are recorded every step (for force sensors).
   void watch_reaction(int group) { watched_ |= GroupMask{1} << group; }
 
+  // Arlequin weighting (DESIGN.md section 2): every DE's mass (and so its inertia) is
+  // multiplied by max(alpha(x_i), mass_floor), every bond's stiffness by alpha at its
+  // midpoint. Call once, after the bonds are added and before finalize(). Contacts are not
+  // weighted (a coupled zone is bonded).
+  void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
+
   void finalize();
 
   // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
@@ -57,8 +64,12 @@ class DemModel {
   // neighbours at setup (at least one), with the stiffness of the contact law.
   double critical_time_step() const;
 
-  // One velocity-Verlet step of size dt (s): the phases, in order.
+  // One velocity-Verlet step of size dt (s): the phases, in order. step() is
+  // advance_to_forces() then finish_step(); a coupled step runs the two halves itself and
+  // corrects velocities after finish_step().
   void step(double dt);
+  void advance_to_forces(double dt);  // kick dt/2, drift dt, forces at t + dt
+  void finish_step(double dt);        // kick dt/2 to the velocities at t + dt
   double time() const { return time_; }
   long steps_done() const { return steps_; }
 

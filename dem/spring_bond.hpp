@@ -12,7 +12,7 @@ namespace arlequin::dem {
 
 class SpringBondSet final : public BondSet {
  public:
-  explicit SpringBondSet(double stiffness) : stiffness_(stiffness) {}
+  explicit SpringBondSet(double stiffness) : nominal_stiffness_(stiffness) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
 
   std::string_view law() const override { return "spring"; }
@@ -22,9 +22,11 @@ class SpringBondSet final : public BondSet {
   double energy(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
+  void scale_stiffness(std::span<const double> factor) override;
 
  private:
-  double stiffness_;                 // K, N/m
+  double nominal_stiffness_;         // K of the case file, N/m
+  std::vector<double> stiffness_;    // K per bond (weighted), N/m
   std::vector<double> rest_length_;  // L0, m
 };
 

@@ -1,0 +1,33 @@
+// Arlequin weighting of the DEM side: masses by max(alpha, floor) at the DE, bond stiffness
+// by alpha at the bond midpoint (DESIGN.md section 2).
+#include <gtest/gtest.h>
+
+#include "support/dem_fixtures.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+TEST(ArlequinWeight, ScalesMassesWithFloorAndBondsAtMidpoint) {
+  DemModel model;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 3, 2.0, 1.0, 1.0);  // x = 0, 2, 4
+  auto& beam = test::bond_all_touching(model, {1e5, 0.3, 0.5});
+  const double m0 = model.particles.mass(0);
+  // alpha falls linearly from 1 at x = 0 to 0 at x = 4.
+  model.apply_arlequin_weight([](const Vec3& x) { return 1.0 - x.x / 4.0; }, 0.05);
+  model.finalize();
+  EXPECT_DOUBLE_EQ(model.particles.mass(0), m0);
+  EXPECT_DOUBLE_EQ(model.particles.mass(1), 0.5 * m0);
+  EXPECT_DOUBLE_EQ(model.particles.mass(2), 0.05 * m0);  // the floor
+  EXPECT_DOUBLE_EQ(model.particles.inertia(1), 0.5 * 0.4 * m0);
+  // Bond midpoints at x = 1 and 3: weights 3/4 and 1/4 of the axial stiffness E S / L.
+  const double k = test::R1Beam::E * test::R1Beam::S / test::R1Beam::L;
+  model.particles.position[1].x += 1e-3;
+  for (std::size_t b = 0; b < beam.size(); ++b) {
+    const auto a = beam.actions(b, model.particles);
+    const double midpoint = 0.5 * (model.particles.reference[beam.first()[b]].x + model.particles.reference[beam.second()[b]].x);
+    EXPECT_NEAR(std::abs(a.axial_force), (1.0 - midpoint / 4.0) * k * 1e-3, 1e-9 * k * 1e-3);
+  }
+}
+
+}  // namespace
+}  // namespace arlequin::dem
