@@ -12,8 +12,10 @@
 
 #include "app/runner.hpp"
 #include "app/scene.hpp"
+#include "app/sweep.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
+#include "common/json.hpp"
 
 namespace {
 
@@ -25,6 +27,7 @@ constexpr const char* usage_main =
     "commands:\n"
     "  run CASE.yaml     run a case, write results (series.csv, fields.h5/.xdmf, summary.json)\n"
     "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
+    "  sweep CASE.yaml   run a case over several values of its keys; table of errors and run times\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -33,18 +36,27 @@ constexpr const char* usage_run =
     "  --out DIR      write results to DIR instead of output.dir of the case\n"
     "  --set k=v      override a case value (YAML syntax), e.g. --set time.end=1e-3\n"
     "  --steps N      stop after N steps\n"
-    "  --quiet        no progress line\n";
+    "  --petsc \"...\"  PETSc options for continuum solves, e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
+    "  --quiet        no progress line\n"
+    "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed\n";
 
 constexpr const char* usage_check =
     "usage: arlequin check CASE.yaml [--set key.path=value ...]\n"
     "  prints the case as resolved (with defaults), the DE and bond counts, the critical\n"
     "  time step and the time step that a run would use\n";
 
+constexpr const char* usage_sweep =
+    "usage: arlequin sweep CASE.yaml --over key.path=v1,v2,... [--over ...] [--out DIR] [--set k=v ...]\n"
+    "  runs every combination of the --over values (results in DIR/<run>/, default\n"
+    "  results/<name>_sweep/), prints a Markdown table of the case's checks (value, relative\n"
+    "  error) against wall time, and writes DIR/sweep.csv\n";
+
 struct Arguments {
   std::string command;
   std::string case_file;
   app::SceneOptions scene;
   long steps = -1;
+  std::vector<app::SweepAxis> axes;
   bool quiet = false;
   bool help = false;
 };
@@ -52,7 +64,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -60,7 +72,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -74,7 +86,11 @@ Arguments parse(int argc, char** argv) {
       a.scene.overrides.push_back(value("key.path=value"));
     } else if (arg.starts_with("--set=")) {
       a.scene.overrides.push_back(arg.substr(6));
-    } else if (arg == "--out" && a.command == "run") {
+    } else if (arg == "--petsc") {
+      a.scene.petsc_options += " " + value("a quoted PETSc option string");
+    } else if (arg == "--over" && a.command == "sweep") {
+      a.axes.push_back(app::parse_sweep_axis(value("key.path=v1,v2,...")));
+    } else if (arg == "--out" && (a.command == "run" || a.command == "sweep")) {
       a.scene.out_dir = value("a directory");
     } else if (arg == "--steps" && a.command == "run") {
       const std::string v = value("a number of steps");
@@ -90,6 +106,7 @@ Arguments parse(int argc, char** argv) {
     }
   }
   if (!a.help && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
+  if (!a.help && a.command == "sweep" && a.axes.empty()) throw InputError("arlequin sweep: give at least one --over key=v1,v2");
   return a;
 }
 
@@ -97,7 +114,13 @@ void print_scene_facts(const app::Scene& scene) {
   const auto& model = scene.dem;
   std::printf("case: %s\n  DEs: %zu\n", scene.name.c_str(), model.particles.size());
   for (const auto& set : model.bond_sets()) std::printf("  %s bonds: %zu\n", std::string(set->law()).c_str(), set->size());
-  std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
+  if (model.particles.size() > 0)
+    std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
+  if (scene.continuum) {
+    Json counts = Json::object();
+    scene.continuum->describe(counts);
+    std::printf("  continuum: %s\n", counts.dump(-1).c_str());
+  }
   std::printf("  critical time step: %.6e s\n  time step: %.6e s (%.3f of critical)\n  steps: %ld to t = %.6e s\n",
               scene.dt_critical, scene.dt, scene.dt / scene.dt_critical,
               static_cast<long>(std::ceil(scene.end_time / scene.dt - 1e-9)), scene.end_time);
@@ -118,8 +141,22 @@ int run(const Arguments& a) {
   std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e\n",
               e.kinetic, e.bond, e.contact, e.external_work, e.dissipated);
   for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
+  for (const auto& c : r.checks)
+    std::printf("check %s %s: %.6e vs %.6e expected (error %.3g %%, tolerance %.3g %%): %s\n", c.check->column.c_str(),
+                c.check->crossing ? "crossing time" : "final value", c.value, c.check->expected, 100 * c.relative_error,
+                100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
   std::printf("results: %s\n", std::filesystem::absolute(scene.output.dir).string().c_str());
-  return 0;
+  return r.all_checks_passed() ? 0 : 5;
+}
+
+int sweep(const Arguments& a) {
+  std::filesystem::path out = a.scene.out_dir;
+  if (out.empty()) out = "results/" + std::filesystem::path(a.case_file).parent_path().filename().string() + "_sweep";
+  app::SceneOptions base = a.scene;
+  base.out_dir.clear();
+  const bool ok = app::run_sweep(a.case_file, base, a.axes, out);
+  std::printf("sweep table: %s\n", std::filesystem::absolute(out / "sweep.csv").string().c_str());
+  return ok ? 0 : 5;
 }
 
 int check(const Arguments& a) {
@@ -136,10 +173,14 @@ int main(int argc, char** argv) {
     const Arguments a = parse(argc, argv);
     if (a.command == "--version") return std::printf("arlequin %s\n", ARLEQUIN_VERSION), 0;
     if (a.help) {
-      std::fputs(a.command == "run" ? usage_run : a.command == "check" ? usage_check : usage_main, stdout);
+      std::fputs(a.command == "run"     ? usage_run
+                 : a.command == "check" ? usage_check
+                 : a.command == "sweep" ? usage_sweep
+                                        : usage_main,
+                 stdout);
       return 0;
     }
-    return a.command == "run" ? run(a) : check(a);
+    return a.command == "run" ? run(a) : a.command == "sweep" ? sweep(a) : check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());
     return 2;

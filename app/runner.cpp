@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -32,21 +33,22 @@ class Outputs {
     std::vector<std::string> columns{"time", "step"};
     for (auto& c : sensor_columns(scene)) columns.push_back(c);
     for (const char* c : energy_columns) columns.push_back(c);
+    if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
     series_.emplace(scene.output.dir / "series.csv", columns);
-    if (scene.output.particle_fields || scene.output.bond_fields)
+    if (scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields)
       fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
     write_file_atomically(scene.output.dir / "case.resolved.yaml", scene.resolved_case);
   }
 
   // One row of series.csv; returns the sensors' values.
-  std::vector<std::pair<std::string, double>> write_row(const dem::Energies& e, double initial_total) {
-    const dem::DemModel& model = scene_.dem;
-    row_.assign({model.time(), double(model.steps_done())});
+  std::vector<std::pair<std::string, double>> write_row(double time, long step, const dem::Energies& e,
+                                                       double initial_total) {
+    row_.assign({time, double(step)});
     std::vector<std::pair<std::string, double>> values;
     const auto names = sensor_columns(scene_);
     std::size_t column = 0;
     for (const Sensor& s : scene_.sensors) {
-      const Vec3 v = s.kind == Sensor::Kind::force ? model.reaction_on(s.group) : model.mean_displacement(s.group);
+      const Vec3 v = sensor_value(s);
       for (int k = 0; k < 3; ++k)
         if (s.component < 0 || s.component == k) {
           row_.push_back(v[k]);
@@ -56,14 +58,43 @@ class Outputs {
     const double balance = e.total() + e.dissipated - e.external_work - initial_total;
     for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.total(), balance})
       row_.push_back(x);
+    if (scene_.continuum) {
+      row_.push_back(scene_.continuum->kinetic_energy());
+      row_.push_back(scene_.continuum->strain_energy());
+    }
     series_->append(row_);
     return values;
   }
 
-  void write_fields() {
+  void write_fields(double time) {
     if (!fields_) return;
+    fields_->begin_frame(time);
+    if (scene_.continuum) scene_.continuum->write_fields(*fields_);
+    if (scene_.dem.particles.size() > 0) write_particles();
+    fields_->end_frame();
+  }
+
+  void close() {
+    series_->flush();
+    if (fields_) fields_->close();
+  }
+  const CsvSeries& series() const { return *series_; }
+
+ private:
+  Vec3 sensor_value(const Sensor& s) const {
+    switch (s.kind) {
+      case Sensor::Kind::force:
+        return s.on_continuum ? scene_.continuum->reaction_on(s.group_name) : scene_.dem.reaction_on(s.group);
+      case Sensor::Kind::displacement:
+        return s.on_continuum ? scene_.continuum->mean_displacement(s.group_name) : scene_.dem.mean_displacement(s.group);
+      case Sensor::Kind::velocity:
+        return s.on_continuum ? scene_.continuum->mean_velocity(s.group_name) : scene_.dem.mean_velocity(s.group);
+    }
+    return {};
+  }
+
+  void write_particles() {
     const dem::ParticleSet& p = scene_.dem.particles;
-    fields_->begin_frame(scene_.dem.time());
     fields_->add_grid("particles", p.position, FieldsWriter::CellKind::Vertex, {});
     scratch_vec_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) scratch_vec_[i] = p.position[i] - p.reference[i];
@@ -87,15 +118,8 @@ class Outputs {
       fields_->add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, scratch_lines_);
       fields_->add_cell_field("bonds", "bond_set", scratch_set_);
     }
-    fields_->end_frame();
   }
 
-  void close() {
-    series_->flush();
-    if (fields_) fields_->close();
-  }
-
- private:
   const Scene& scene_;
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
@@ -141,14 +165,24 @@ Json energies_json(const dem::Energies& e) {
 
 }  // namespace
 
-std::vector<std::string> sensor_columns(const Scene& scene) {
-  std::vector<std::string> out;
-  for (const Sensor& s : scene.sensors) {
-    if (s.component >= 0) {
-      out.push_back(s.name);
-    } else {
-      for (const char* axis : {"_x", "_y", "_z"}) out.push_back(s.name + axis);
+// Evaluates the case's checks on the rows of series.csv.
+std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const CsvSeries& series) {
+  std::vector<RunResult::CheckResult> out;
+  const auto& columns = series.columns();
+  for (const Check& c : scene.checks) {
+    const std::size_t col = std::find(columns.begin(), columns.end(), c.column) - columns.begin();
+    double value = std::numeric_limits<double>::quiet_NaN();
+    if (!c.crossing && series.rows() > 0) value = series.row(series.rows() - 1)[col];
+    for (std::size_t r = 1; c.crossing && r < series.rows(); ++r) {
+      const double a = series.row(r - 1)[col] - c.threshold, b = series.row(r)[col] - c.threshold;
+      if ((a < 0) != (b < 0) || b == 0) {  // linear interpolation of the crossing time
+        const double t0 = series.row(r - 1)[0], t1 = series.row(r)[0];
+        value = t0 + (t1 - t0) * a / (a - b);
+        break;
+      }
     }
+    const double error = std::abs(value - c.expected) / std::max(std::abs(c.expected), 1e-300);
+    out.push_back({&c, value, error, error <= c.tolerance});
   }
   return out;
 }
@@ -169,15 +203,17 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
   // Float steps accumulate round-off: an output is due within a millionth of a step.
   const double slack = 1e-6 * scene.dt;
+  long steps_done = 0;
+  const auto current_time = [&] { return steps_done * scene.dt; };
   const auto write_outputs = [&] {
     const auto t0 = Clock::now();
     result.energies = model.energies();
-    if (model.time() + slack >= next_row || model.steps_done() == total_steps) {
-      result.sensors = outputs.write_row(result.energies, initial_total);
+    if (current_time() + slack >= next_row || steps_done == total_steps) {
+      result.sensors = outputs.write_row(current_time(), steps_done, result.energies, initial_total);
       next_row += scene.output.every;
     }
-    if (model.time() + slack >= next_frame || model.steps_done() == total_steps) {
-      outputs.write_fields();
+    if (current_time() + slack >= next_frame || steps_done == total_steps) {
+      outputs.write_fields(current_time());
       next_frame += scene.output.fields_every;
     }
     output_seconds += seconds_since(t0);
@@ -186,22 +222,28 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const auto t_start = Clock::now();
   std::string failure;
   try {
+    if (scene.continuum && scene.continuum->is_static() && model.particles.size() == 0) {
+      scene.continuum->solve_static();  // a static continuum alone: one solve, one output
+      total_steps = 0;
+    }
     write_outputs();
     for (long n = 1; n <= total_steps; ++n) {
-      model.step(scene.dt);
+      if (model.particles.size() > 0) model.step(scene.dt);
+      if (scene.continuum) scene.continuum->step(scene.dt);
+      ++steps_done;
       if (n == 1) energy_scale = std::max(energy_scale, model.energies().kinetic);
       model.check_finite();
       if (n % 50 == 0 || n == total_steps)
         model.check_energy(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
-      if (model.time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
-      progress.update(n, model.time());
+      if (current_time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
+      progress.update(n, current_time());
     }
   } catch (const RunError& e) {
     failure = e.what();
   }
   progress.finish();
-  result.steps = model.steps_done();
-  result.simulated_time = model.time();
+  result.steps = steps_done;
+  result.simulated_time = current_time();
   result.wall_seconds = seconds_since(t_start);
   outputs.close();
 
@@ -218,6 +260,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Json& counts = summary["counts"];
   counts["particles"] = model.particles.size();
   for (const auto& set : model.bond_sets()) counts[std::string(set->law()) + "_bonds"] = set->size();
+  if (scene.continuum) scene.continuum->describe(counts);
   if (const auto* list = model.neighbours()) {
     counts["contact_candidates"] = list->pairs().size();
     counts["neighbour_rebuilds"] = list->builds();
@@ -228,6 +271,21 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   wall["output"] = output_seconds;
   wall["steps_per_second"] = result.steps / std::max(result.wall_seconds - output_seconds, 1e-9);
   summary["energies"] = energies_json(result.energies);
+  if (failure.empty()) result.checks = evaluate_checks(scene, outputs.series());
+  Json& checks = summary["checks"];
+  checks = Json::array();
+  for (const auto& c : result.checks) {
+    Json j = Json::object();
+    j["column"] = c.check->column;
+    j["kind"] = c.check->crossing ? "crossing time" : "final value";
+    j["value"] = c.value;
+    j["expected"] = c.check->expected;
+    j["relative_error"] = c.relative_error;
+    j["tolerance"] = c.check->tolerance;
+    j["passed"] = c.passed;
+    if (!c.check->note.empty()) j["note"] = c.check->note;
+    checks.push_back(j);
+  }
   Json& sensors = summary["sensors"];
   sensors = Json::object();
   for (const auto& [name, value] : result.sensors) sensors[name] = value;

@@ -4,6 +4,7 @@
 // Contract: on success returns the run's figures; on a RunError (NaN, blow-up) the outputs so
 // far are flushed and closed, summary.json records the failure, and the error is rethrown.
 #pragma once
+#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,11 +25,18 @@ struct RunResult {
   double wall_seconds = 0.0;    // time loop only
   dem::Energies energies;
   std::vector<std::pair<std::string, double>> sensors;  // last value of each column
+  struct CheckResult {
+    const Check* check;
+    double value;           // final value, or crossing time (NaN: never reached)
+    double relative_error;
+    bool passed;
+  };
+  std::vector<CheckResult> checks;
+  bool all_checks_passed() const {
+    return std::all_of(checks.begin(), checks.end(), [](const CheckResult& c) { return c.passed; });
+  }
 };
 
 RunResult run_scene(Scene& scene, const RunOptions& options);
-
-// Column names of series.csv for the scene's sensors (one, or three for component: all).
-std::vector<std::string> sensor_columns(const Scene& scene);
 
 }  // namespace arlequin::app

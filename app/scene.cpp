@@ -146,7 +146,9 @@ void read_initial(CaseNode root, dem::DemModel& model) {
 }
 
 void read_sensors(CaseNode root, Scene& scene) {
-  static constexpr std::string_view types[] = {"force", "displacement"};
+  static constexpr std::string_view types[] = {"force", "displacement", "velocity"};
+  static constexpr std::string_view models[] = {"dem", "continuum"};
+  const bool has_dem = scene.dem.particles.size() > 0;
   for (CaseNode s : root.list_or_empty("sensors")) {
     Sensor sensor;
     sensor.name = s.string("name");
@@ -154,18 +156,49 @@ void read_sensors(CaseNode root, Scene& scene) {
       s.fail("name", "expected a non-empty name without commas, quotes or spaces");
     for (const Sensor& other : scene.sensors)
       if (other.name == sensor.name) s.fail("name", "sensor '" + sensor.name + "' is defined twice");
-    sensor.kind = s.choice("type", types) == "force" ? Sensor::Kind::force : Sensor::Kind::displacement;
-    sensor.group = group_of(s, scene.dem);
+    const std::string type = s.choice("type", types);
+    sensor.kind = type == "force" ? Sensor::Kind::force
+                  : type == "displacement" ? Sensor::Kind::displacement : Sensor::Kind::velocity;
+    sensor.on_continuum = s.choice_or("on", has_dem ? "dem" : "continuum", models) == "continuum";
+    if (sensor.on_continuum) {
+      if (!scene.continuum) s.fail("on", "the case has no continuum");
+      sensor.group_name = s.string("group");
+      if (!scene.continuum->has_group(sensor.group_name))
+        s.fail("group", "the continuum mesh has no physical group '" + sensor.group_name + "'");
+    } else {
+      if (!has_dem) s.fail("on", "the case has no DEM");
+      sensor.group = group_of(s, scene.dem);
+      sensor.group_name = s.string("group");
+      if (sensor.kind == Sensor::Kind::force) scene.dem.watch_reaction(sensor.group);
+    }
     const std::string c = s.choice_or("component", "all", component_names);
     sensor.component = c == "all" ? -1 : c[0] - 'x';
     s.finish();
-    if (sensor.kind == Sensor::Kind::force) scene.dem.watch_reaction(sensor.group);
     scene.sensors.push_back(sensor);
   }
 }
 
+void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& columns) {
+  for (CaseNode c : root.list_or_empty("checks")) {
+    Check check;
+    check.column = c.string("column");
+    if (std::find(columns.begin(), columns.end(), check.column) == columns.end()) {
+      std::string known;
+      for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
+      c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
+    }
+    check.crossing = c.has("crossing");
+    if (check.crossing) check.threshold = c.number("crossing", Range::any(), "column unit");
+    check.expected = c.number("expected", Range::any(), check.crossing ? "s" : "column unit");
+    check.tolerance = c.number("tolerance", Range::positive(), "1");
+    check.note = c.string_or("note", "");
+    c.finish();
+    scene.checks.push_back(check);
+  }
+}
+
 void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& options) {
-  static constexpr std::string_view field_kinds[] = {"particles", "bonds"};
+  static constexpr std::string_view field_kinds[] = {"particles", "bonds", "continuum"};
   OutputPlan& plan = scene.output;
   plan.dir = "results/" + scene.name;
   plan.every = scene.end_time / 100.0;
@@ -174,8 +207,8 @@ void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& 
     plan.every = out->number_or("every", plan.every, Range::positive(), "s");
     for (const std::string& f : out->strings_or("fields", {})) {
       if (std::find(std::begin(field_kinds), std::end(field_kinds), f) == std::end(field_kinds))
-        out->fail("fields", "unknown field set '" + f + "' (expected particles, bonds)");
-      (f == "particles" ? plan.particle_fields : plan.bond_fields) = true;
+        out->fail("fields", "unknown field set '" + f + "' (expected particles, bonds, continuum)");
+      (f == "particles" ? plan.particle_fields : f == "bonds" ? plan.bond_fields : plan.continuum_fields) = true;
     }
     plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
     out->finish();
@@ -184,6 +217,18 @@ void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& 
 }
 
 }  // namespace
+
+std::vector<std::string> sensor_columns(const Scene& scene) {
+  std::vector<std::string> out;
+  for (const Sensor& s : scene.sensors) {
+    if (s.component >= 0) {
+      out.push_back(s.name);
+    } else {
+      for (const char* axis : {"_x", "_y", "_z"}) out.push_back(s.name + axis);
+    }
+  }
+  return out;
+}
 
 Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options) {
   CaseFile file = CaseFile::load(case_file, options.overrides);
@@ -194,48 +239,63 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   static constexpr std::string_view unit_systems[] = {"SI"};
   root.choice_or("units", "SI", unit_systems);
 
-  CaseNode time = root.child("time");
-  scene.end_time = time.number("end", Range::positive(), "s");
-  const std::optional<double> user_dt = time.number_or_auto("dt", Range::positive(), "s");
-  scene.safety = time.number_or("safety", 0.3, Range::open_between(0.0, 1.0), "1");
-  time.finish();
-
-  CaseNode dem_node = root.child("dem");
+  // The models first: the time section's defaults depend on them.
+  std::optional<CaseNode> dem_node = root.child_if("dem");
+  std::optional<CaseNode> continuum_node = root.child_if("continuum");
+  if (!dem_node && !continuum_node) root.fail("dem", "a case needs a dem section, a continuum section, or both");
   dem::DemModel& model = scene.dem;
-  const double density = dem_node.number("density", Range::positive(), "kg/m^3");
-  read_sample(dem_node.child("sample"), model.particles, density);
-  if (auto bond = dem_node.child_if("bond")) read_bonds(*bond, model);
-  if (auto contact = dem_node.child_if("contact")) {
-    double mean_radius = 0.0;
-    for (double r : model.particles.radius) mean_radius += r;
-    mean_radius /= double(model.particles.size());
-    const double skin = contact->number_or("skin", 0.2 * mean_radius, Range::positive(), "m");
-    model.set_contact(dem::make_contact_law(*contact), skin);
-    contact->finish();
+  if (dem_node) {
+    const double density = dem_node->number("density", Range::positive(), "kg/m^3");
+    read_sample(dem_node->child("sample"), model.particles, density);
+    if (auto bond = dem_node->child_if("bond")) read_bonds(*bond, model);
+    if (auto contact = dem_node->child_if("contact")) {
+      double mean_radius = 0.0;
+      for (double r : model.particles.radius) mean_radius += r;
+      mean_radius /= double(model.particles.size());
+      const double skin = contact->number_or("skin", 0.2 * mean_radius, Range::positive(), "m");
+      model.set_contact(dem::make_contact_law(*contact), skin);
+      contact->finish();
+    }
+    model.set_damping(dem_node->number_or("damping", 0.0, Range::non_negative(), "1/s"));
+    dem_node->finish();
   }
-  model.set_damping(dem_node.number_or("damping", 0.0, Range::non_negative(), "1/s"));
-  dem_node.finish();
+  if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, options.petsc_options);
+  const bool static_only = !dem_node && scene.continuum->is_static();
 
-  read_groups(root, model);
-  read_initial(root, model);
+  if (dem_node) {
+    read_groups(root, model);
+    read_initial(root, model);
+  }
   read_sensors(root, scene);
-  read_boundary(root, model);
+  if (dem_node) read_boundary(root, model);
+
+  std::optional<CaseNode> time = static_only ? root.child_if("time") : root.child("time");
+  scene.end_time = time ? time->number("end", Range::positive(), "s") : 1.0;
+  const std::optional<double> user_dt = time ? time->number_or_auto("dt", Range::positive(), "s") : std::nullopt;
+  scene.safety = time ? time->number_or("safety", 0.3, Range::open_between(0.0, 1.0), "1") : 0.3;
+  if (time) time->finish();
 
   scene.dt_critical = model.critical_time_step();
-  if (user_dt) {
+  if (scene.continuum) scene.dt_critical = std::min(scene.dt_critical, scene.continuum->critical_time_step());
+  if (static_only) {
+    scene.dt = scene.end_time;  // one static solve
+  } else if (user_dt) {
     if (*user_dt > scene.dt_critical) {
       std::ostringstream msg;
       msg << "time step " << *user_dt << " s is above the critical time step " << scene.dt_critical
-          << " s (2/omega_max over bonds and contacts); use dt <= " << scene.dt_critical << " or dt: auto";
-      time.fail("dt", msg.str());
+          << " s (2/omega_max over bonds, contacts and the continuum); use dt <= " << scene.dt_critical << " or dt: auto";
+      time->fail("dt", msg.str());
     }
     scene.dt = *user_dt;
   } else {
     if (!std::isfinite(scene.dt_critical))
-      time.fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
+      time->fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
     scene.dt = scene.safety * scene.dt_critical;
   }
   read_output(root.child_if("output"), scene, options);
+  std::vector<std::string> columns = sensor_columns(scene);
+  columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_total"});
+  read_checks(root, scene, columns);
   root.finish();
   scene.resolved_case = file.resolved_yaml();
   return scene;

@@ -4,7 +4,8 @@
 //
 // Case-file schema (SI units; every key checked; see cases/*/case.yaml for examples):
 //   name, units: SI
-//   time:    {end [s], dt: auto | [s], safety: 0.3}
+//   time:    {end [s], dt: auto | [s], safety: 0.3}   (optional for a static continuum alone)
+//   (at least one of dem and continuum; continuum: see app/continuum_part.hpp)
 //   dem:     {sample: {build: lattice | chain | particles, ...}, density [kg/m^3],
 //             bond: {law: <bond law>, tolerance, ...law parameters},      (optional)
 //             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
@@ -12,23 +13,40 @@
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
 //   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rotation}]
 //   initial:  [{group, velocity [m/s], angular_velocity [rad/s]}]
-//   sensors:  [{name, type: force | displacement, group, component: x | y | z | all}]
-//   output:   {dir, every [s], fields: [particles, bonds], fields_every [s]}
+//   sensors:  [{name, type: force | displacement | velocity, group, component: x | y | z | all,
+//               on: dem | continuum (default: the model the case has; dem if both)}]
+//   checks:   [{column, expected, tolerance, note} | {column, crossing: value, expected: time [s], tolerance, note}]
+//   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s]}
 #pragma once
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "app/continuum_part.hpp"
 #include "dem/dem_model.hpp"
 
 namespace arlequin::app {
 
 struct Sensor {
-  enum class Kind { force, displacement };
+  enum class Kind { force, displacement, velocity };
   std::string name;
   Kind kind = Kind::force;
-  int group = -1;
+  bool on_continuum = false;  // else on the DEM
+  int group = -1;             // DEM group index
+  std::string group_name;
   int component = -1;  // 0, 1, 2, or -1 for all three
+};
+
+// An acceptance check of the case against its reference, evaluated on series.csv after the run:
+// the final value of a sensor column, or the first time a column reaches a value (a wave's
+// arrival). Relative tolerance.
+struct Check {
+  std::string column;
+  bool crossing = false;      // else: final value
+  double threshold = 0.0;     // crossing: the value to reach
+  double expected = 0.0;      // final value, or crossing time (s)
+  double tolerance = 0.0;     // relative
+  std::string note;           // where the expected value comes from
 };
 
 struct OutputPlan {
@@ -37,25 +55,32 @@ struct OutputPlan {
   double fields_every = 0.0;  // s, HDF5 frames
   bool particle_fields = false;
   bool bond_fields = false;
+  bool continuum_fields = false;
 };
 
 struct Scene {
   std::string name;
   std::filesystem::path case_file;
   std::string resolved_case;  // YAML with defaults, as read
-  dem::DemModel dem;
+  dem::DemModel dem;                           // empty (no DE) without a dem section
+  std::unique_ptr<ContinuumPart> continuum;    // null without a continuum section
   double end_time = 0.0;      // s
   double dt = 0.0;            // s
   double dt_critical = 0.0;   // s
   double safety = 0.3;
   std::vector<Sensor> sensors;
+  std::vector<Check> checks;
   OutputPlan output;
 };
 
 struct SceneOptions {
   std::vector<std::string> overrides;  // --set key=value
   std::filesystem::path out_dir;       // --out, empty = from the case
+  std::string petsc_options;           // --petsc "...", after the case's own
 };
+
+// Column names of series.csv for the scene's sensors (one, or three for component: all).
+std::vector<std::string> sensor_columns(const Scene& scene);
 
 // Throws InputError with file:line: key: message for any problem in the case.
 Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options);

@@ -236,16 +236,25 @@ Energies DemModel::energies() const {
   return e;
 }
 
-Vec3 DemModel::mean_displacement(int group) const {
+template <class Value>
+Vec3 DemModel::group_mean(int group, Value value) const {
   Vec3 sum{};
   std::size_t count = 0;
   const GroupMask bit = GroupMask{1} << group;
   for (std::size_t i = 0; i < particles.size(); ++i)
     if (particles.groups[i] & bit) {
-      sum += particles.position[i] - particles.reference[i];
+      sum += value(i);
       ++count;
     }
   return count ? sum / static_cast<double>(count) : Vec3{};
+}
+
+Vec3 DemModel::mean_displacement(int group) const {
+  return group_mean(group, [&](std::size_t i) { return particles.position[i] - particles.reference[i]; });
+}
+
+Vec3 DemModel::mean_velocity(int group) const {
+  return group_mean(group, [&](std::size_t i) { return particles.velocity[i]; });
 }
 
 void DemModel::check_finite() const {

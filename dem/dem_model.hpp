@@ -77,7 +77,8 @@ class DemModel {
   double external_work() const { return external_work_; }  // J, cheap (no energy sums)
   // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
   Vec3 reaction_on(int group) const { return reaction_[group]; }
-  Vec3 mean_displacement(int group) const;
+  Vec3 mean_displacement(int group) const;  // m
+  Vec3 mean_velocity(int group) const;      // m/s
   // Both throw RunError naming the step, the DE and the likely cause. check_finite: any
   // non-finite velocity (cheap, meant for every step); check_energy: kinetic energy above
   // energy_limit (J), a blow-up.
@@ -85,6 +86,8 @@ class DemModel {
   void check_energy(double energy_limit) const;
 
  private:
+  template <class Value>
+  Vec3 group_mean(int group, Value value) const;
   void kick(double half_dt);
   void impose_motion(double t, bool half_step, double dt);
   void drift(double dt);

@@ -100,7 +100,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),
-    [](const auto& info) { return info.param.name; });
+    [](const auto& param_info) { return param_info.param.name; });
 
 TEST(BadInput, MissingCaseFile) {
   const auto r = test::run_arlequin("run /nonexistent/folder/case.yaml");

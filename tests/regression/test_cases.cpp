@@ -63,6 +63,33 @@ TEST(Cases, BondedBlockShortRunBalancesEnergyWithoutContactSearch) {
   EXPECT_NEAR(relative_balance(s), 0.0, 1e-3 * work);
 }
 
+// Continuum cases: the run's own checks (closed forms) decide the exit code.
+TEST(Cases, ContinuumCasesPassTheirChecksWithBothSolvers) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  for (const char* solver : {"fe", "nem"}) {
+    const Json cantilever = run_case("cantilever_continuum", std::string("--set continuum.solver=") + solver);
+    EXPECT_TRUE(cantilever.at("checks").as_array().at(0).at("passed").as_bool()) << solver;
+    const Json bar = run_case("bar_wave_continuum", std::string("--set continuum.solver=") + solver);
+    EXPECT_TRUE(bar.at("checks").as_array().at(0).at("passed").as_bool()) << solver;
+  }
+}
+
+TEST(Cli, SweepTabulatesErrorAgainstRunTime) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("sweep");
+  const auto r = test::run_arlequin("sweep " + cases + "cantilever_continuum/case.yaml --over continuum.mesh.size=0.5,0.4 --out " +
+                                        out.string(), "stdout");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  const std::string csv = test::read_text(out / "sweep.csv");
+  EXPECT_NE(csv.find("continuum.mesh.size,particles,continuum_nodes,steps,tip_deflection,tip_deflection_relative_error,wall_seconds,status"),
+            std::string::npos) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+}
+
 TEST(Cli, VersionHelpAndCheck) {
   EXPECT_EQ(test::run_arlequin("--version", "stdout").exit_code, 0);
   EXPECT_NE(test::run_arlequin("run --help", "stdout").output.find("--steps"), std::string::npos);
@@ -77,7 +104,7 @@ TEST(Cli, VersionHelpAndCheck) {
 // outputs written so far stay readable (series.csv rows, summary.json with the failure).
 TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
   const auto out = test::scratch_dir("nan_stop");
-  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {{}, out});
+  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
   const double nan = std::numeric_limits<double>::quiet_NaN();
   app::RunOptions options;
   options.max_steps = 400;

@@ -1,0 +1,188 @@
+#include "app/continuum_part.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+#include "common/fields_writer.hpp"
+#include "common/json.hpp"
+#include "continuum/continuum_solver.hpp"
+#include "continuum/registry.hpp"
+
+namespace arlequin::app {
+namespace {
+
+using continuum::ContinuumSolver;
+
+continuum::Material read_material(CaseNode m) {
+  static constexpr std::string_view models[] = {"isotropic", "transversely_isotropic"};
+  const std::string model = m.choice_or("model", "isotropic", models);
+  const double density = m.number("density", Range::positive(), "kg/m^3");
+  continuum::Material material;
+  if (model == "isotropic") {
+    material = continuum::Material::isotropic(m.number("E", Range::positive(), "Pa"),
+                                              m.number("nu", Range::open_between(-1.0, 0.5), "1"), density);
+  } else {
+    const double E_L = m.number("E_L", Range::positive(), "Pa"), E_T = m.number("E_T", Range::positive(), "Pa");
+    const double nu_LT = m.number("nu_LT", Range::open_between(-1.0, 0.5), "1");
+    const double nu_TT = m.number("nu_TT", Range::open_between(-1.0, 1.0), "1");
+    const double G_LT = m.number("G_LT", Range::positive(), "Pa");
+    const Vec3 axis = m.vec3("axis", Range::any(), "1");
+    if (!(norm(axis) > 0.0)) m.fail("axis", "expected a non-zero direction");
+    material = continuum::Material::transversely_isotropic(E_L, E_T, nu_LT, nu_TT, G_LT, normalized(axis), density);
+  }
+  m.finish();
+  return material;
+}
+
+class Part final : public ContinuumPart {
+ public:
+  Part(CaseNode section, const std::string& extra_petsc_options) {
+    std::vector<std::string_view> names;
+    for (const auto& e : continuum::continuum_solvers()) names.push_back(e.name);
+    const std::string name = section.choice("solver", names);
+    continuum::ContinuumSettings settings;
+    CaseNode mesh = section.child("mesh");
+    settings.mesh.path = mesh.existing_file("file").string();
+    settings.mesh.size = mesh.number_or("size", 0.0, Range::non_negative(), "m");
+    settings.mesh.order = int(mesh.integer_or("order", 1, Range::between(1, 2)));
+    mesh.finish();
+    settings.materials.push_back({"", read_material(section.child("material"))});
+    static constexpr std::string_view shapes[] = {"sibson", "laplace"};
+    settings.shape_functions = section.choice_or("shape_functions", "sibson", shapes);
+    settings.petsc_options = section.string_or("petsc_options", "") + " " + extra_petsc_options;
+    static constexpr std::string_view analyses[] = {"explicit", "static"};
+    static_ = section.choice_or("analysis", "explicit", analyses) == "static";
+    petsc_options_ = settings.petsc_options;
+    try {
+      solver_ = continuum::make_continuum_solver(name, settings);
+    } catch (const InputError& e) {
+      mesh.fail("file", e.what());
+    }
+    for (CaseNode bc : section.list_or_empty("boundary")) read_boundary(bc);
+    section.finish();
+  }
+
+  ContinuumSolver& solver() override { return *solver_; }
+  bool is_static() const override { return static_; }
+  double critical_time_step() const override { return static_ ? INFINITY : solver_->critical_time_step(); }
+  void step(double dt) override { solver_->step(dt); }
+  void solve_static() override { solver_->solve_static(petsc_options_); }
+  bool has_group(const std::string& name) const override { return solver_->mesh().has_group(name); }
+
+  Vec3 mean_displacement(const std::string& group) const override { return node_mean(solver_->displacement(), group); }
+  Vec3 mean_velocity(const std::string& group) const override { return node_mean(solver_->velocity(), group); }
+  Vec3 reaction_on(const std::string& group) const override {
+    Vec3 sum{};
+    for (int n : solver_->mesh().group(group).nodes) sum -= node_vector(solver_->force(), n);
+    return sum;
+  }
+  double kinetic_energy() const override { return solver_->kinetic_energy(); }
+  double strain_energy() const override { return solver_->strain_energy(); }
+
+  void write_fields(FieldsWriter& fields) const override {
+    const auto& mesh = solver_->mesh();
+    const int npe = mesh.nodes_per_tet();
+    // VTK/XDMF quadratic tetrahedron: corners, then edges (0,1) (1,2) (0,2) (0,3) (1,3) (2,3);
+    // our node 4+k sits on kTetEdges[k] = (0,1) (0,2) (0,3) (1,2) (1,3) (2,3).
+    static constexpr int vtk_from_ours[10] = {0, 1, 2, 3, 4, 7, 5, 6, 8, 9};
+    std::vector<std::int64_t> connectivity;
+    connectivity.reserve(std::size_t(mesh.num_tets()) * npe);
+    for (int e = 0; e < mesh.num_tets(); ++e)
+      for (int k = 0; k < npe; ++k) connectivity.push_back(mesh.tet(e)[npe == 4 ? k : vtk_from_ours[k]]);
+    fields.add_grid("continuum", mesh.nodes(),
+                    npe == 4 ? FieldsWriter::CellKind::Tetrahedron : FieldsWriter::CellKind::Tetrahedron10, connectivity);
+    fields.add_point_field("continuum", "displacement", as_vectors(solver_->displacement()));
+    fields.add_point_field("continuum", "velocity", as_vectors(solver_->velocity()));
+    // Stress lives at the method's integration points: a point cloud of its own.
+    const auto stress = solver_->point_stress();
+    fields.add_grid("continuum_points", solver_->point_positions(), FieldsWriter::CellKind::Vertex, {});
+    static constexpr const char* names[6] = {"stress_xx", "stress_yy", "stress_zz", "stress_yz", "stress_xz", "stress_xy"};
+    std::vector<double> component(stress.size()), mises(stress.size());
+    for (int c = 0; c < 6; ++c) {
+      for (std::size_t q = 0; q < stress.size(); ++q) component[q] = stress[q](c);
+      fields.add_point_field("continuum_points", names[c], component);
+    }
+    for (std::size_t q = 0; q < stress.size(); ++q) {
+      const auto& s = stress[q];
+      mises[q] = std::sqrt(0.5 * ((s(0) - s(1)) * (s(0) - s(1)) + (s(1) - s(2)) * (s(1) - s(2)) + (s(2) - s(0)) * (s(2) - s(0))) +
+                           3.0 * (s(3) * s(3) + s(4) * s(4) + s(5) * s(5)));
+    }
+    fields.add_point_field("continuum_points", "von_mises", mises);
+  }
+
+  void describe(Json& counts) const override {
+    counts["continuum_nodes"] = solver_->num_nodes();
+    counts["continuum_tetrahedra"] = solver_->mesh().num_tets();
+    counts["continuum_order"] = solver_->mesh().order();
+  }
+
+ private:
+  static Vec3 node_vector(const continuum::Field& f, int n) { return {f[3 * n], f[3 * n + 1], f[3 * n + 2]}; }
+  Vec3 node_mean(const continuum::Field& f, const std::string& group) const {
+    const auto& nodes = solver_->mesh().group(group).nodes;
+    Vec3 sum{};
+    for (int n : nodes) sum += node_vector(f, n);
+    return sum / double(nodes.size());
+  }
+  static std::vector<Vec3> as_vectors(const continuum::Field& f) {
+    std::vector<Vec3> out(f.size() / 3);
+    for (std::size_t n = 0; n < out.size(); ++n) out[n] = node_vector(f, int(n));
+    return out;
+  }
+
+  void read_boundary(CaseNode bc) {
+    static constexpr std::string_view kinds[] = {"fixed", "displacement", "velocity", "traction"};
+    const std::string group = bc.string("group");
+    if (!solver_->mesh().has_group(group)) {
+      std::string known;
+      for (const auto& g : solver_->mesh().groups()) known += (known.empty() ? "" : ", ") + g.name;
+      bc.fail("group", "the mesh has no physical group '" + group + "' (it has: " + known + ")");
+    }
+    const std::string kind = bc.choice("type", kinds);
+    if (kind == "traction") {
+      if (solver_->mesh().group(group).dim != 2) bc.fail("group", "a traction needs a surface group");
+      const Vec3 t = bc.vec3("value", Range::any(), "Pa");
+      solver_->add_traction(group, [t](const Vec3&, double) { return t; });
+      bc.finish();
+      return;
+    }
+    std::array<bool, 3> components{true, true, true};
+    if (bc.has("components")) {
+      components = {false, false, false};
+      for (const std::string& c : bc.strings("components")) {
+        if (c != "x" && c != "y" && c != "z") bc.fail("components", "expected a list of x, y, z, got '" + c + "'");
+        components[c[0] - 'x'] = true;
+      }
+    }
+    continuum::VectorFunction g = [](const Vec3&, double) { return Vec3{}; };
+    if (kind == "displacement") {
+      const Vec3 u = bc.vec3("value", Range::any(), "m");
+      g = [u](const Vec3&, double) { return u; };
+    } else if (kind == "velocity") {
+      const Vec3 v = bc.vec3("value", Range::any(), "m/s");
+      const double rise = bc.number_or("rise", 0.0, Range::non_negative(), "s");
+      const double duration = bc.number_or("duration", INFINITY, Range::positive(), "s");
+      if (rise > duration) bc.fail("rise", "the rise time must not exceed the duration");
+      // Velocity v min(t / rise, 1) until `duration`, then held: g(t) is its integral.
+      const auto travel = [rise](double t) { return t < rise ? 0.5 * t * t / rise : t - 0.5 * rise; };
+      g = [v, duration, travel](const Vec3&, double t) { return v * travel(std::min(t, duration)); };
+    }
+    bc.finish();
+    solver_->fix(group, components, g);
+  }
+
+  std::unique_ptr<ContinuumSolver> solver_;
+  std::string petsc_options_;
+  bool static_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, const std::string& extra_petsc_options) {
+  return std::make_unique<Part>(section, extra_petsc_options);
+}
+
+}  // namespace arlequin::app

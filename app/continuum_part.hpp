@@ -1,0 +1,61 @@
+// The scene's continuum, read from the case file's `continuum:` section: the solver chosen by
+// name from the registry (fe, nem), its mesh, material, boundary conditions and analysis.
+// The one adapter between the application and continuum/: its header names no continuum type,
+// so scenes without a continuum never start PETSc or read a mesh.
+//
+// Case-file section (SI units):
+//   continuum:
+//     solver: fe | nem
+//     mesh: {file: path/to/mesh.geo | .msh, size [m] (for .geo), order: 1 | 2}
+//     material: {E [Pa], nu, density [kg/m^3]}
+//             | {model: transversely_isotropic, E_L, E_T, nu_LT, nu_TT, G_LT [Pa], axis, density}
+//     shape_functions: sibson | laplace           (nem)
+//     petsc_options: "-ksp_type cg -pc_type gamg" (static solves; --petsc on the command line adds)
+//     analysis: explicit | static
+//     boundary:
+//       - {group, type: fixed, components: [x, y, z]}
+//       - {group, type: displacement, value [m]}            constant imposed displacement
+//       - {group, type: velocity, value [m/s], rise [s], duration [s]}  velocity ramped up over
+//         `rise` (linear), imposed until `duration`, then the displacement is held
+//       - {group, type: traction, value [Pa]}               on a surface group
+#pragma once
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "common/vec3.hpp"
+
+namespace arlequin {
+class CaseNode;
+class FieldsWriter;
+class Json;
+namespace continuum {
+class ContinuumSolver;
+}
+}  // namespace arlequin
+
+namespace arlequin::app {
+
+class ContinuumPart {
+ public:
+  // Builds the continuum; InputError for any problem (also when this build has no continuum).
+  static std::unique_ptr<ContinuumPart> read(CaseNode section, const std::string& extra_petsc_options);
+  virtual ~ContinuumPart() = default;
+
+  virtual continuum::ContinuumSolver& solver() = 0;
+  virtual bool is_static() const = 0;
+  virtual double critical_time_step() const = 0;
+  virtual void step(double dt) = 0;    // one explicit step
+  virtual void solve_static() = 0;     // equilibrium at the current time
+  virtual bool has_group(const std::string& name) const = 0;
+  virtual Vec3 mean_displacement(const std::string& group) const = 0;  // over the group's nodes, m
+  virtual Vec3 mean_velocity(const std::string& group) const = 0;      // m/s
+  // Force that supports and loads apply to the group's nodes, -(f_ext - f_int) summed, N.
+  virtual Vec3 reaction_on(const std::string& group) const = 0;
+  virtual double kinetic_energy() const = 0;
+  virtual double strain_energy() const = 0;
+  virtual void write_fields(FieldsWriter& fields) const = 0;
+  virtual void describe(Json& counts) const = 0;
+};
+
+}  // namespace arlequin::app

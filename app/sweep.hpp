@@ -1,0 +1,27 @@
+// `arlequin sweep`: runs one case over the Cartesian product of overridden values and tabulates,
+// per run, the case's checks (value, relative error) against the wall time: the user's
+// "error against run time" view of a discretisation or solver choice.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/scene.hpp"
+
+namespace arlequin::app {
+
+struct SweepAxis {
+  std::string key;                  // case key path, e.g. continuum.mesh.size
+  std::vector<std::string> values;  // YAML texts
+};
+
+// Parses "key=v1,v2,v3"; InputError naming the option if malformed.
+SweepAxis parse_sweep_axis(const std::string& text);
+
+// Runs every combination into out_dir/<run index>/, prints a Markdown table on stdout and
+// writes out_dir/sweep.csv (atomically). Returns false if any run failed or missed a check.
+bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
+               const std::vector<SweepAxis>& axes, const std::filesystem::path& out_dir);
+
+}  // namespace arlequin::app
