@@ -138,12 +138,12 @@ int run(const Arguments& a) {
   std::printf("done: %ld steps, t = %.6e s, wall %.3f s (%.0f steps/s), setup %.3f s\n", r.steps, r.simulated_time,
               r.wall_seconds, r.steps / std::max(r.wall_seconds, 1e-9), options.setup_seconds);
   const auto& e = r.energies;
-  std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e\n",
-              e.kinetic, e.bond, e.contact, e.external_work, e.dissipated);
+  std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e  fracture %.6e\n",
+              e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture);
   for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
   for (const auto& c : r.checks)
     std::printf("check %s %s: %.6e vs %.6e expected (error %.3g %%, tolerance %.3g %%): %s\n", c.check->column.c_str(),
-                c.check->crossing ? "crossing time" : "final value", c.value, c.check->expected, 100 * c.relative_error,
+                app::describe(c.check->kind), c.value, c.check->expected, 100 * c.relative_error,
                 100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
   std::printf("results: %s\n", std::filesystem::absolute(scene.output.dir).string().c_str());
   return r.all_checks_passed() ? 0 : 5;

@@ -1,5 +1,6 @@
 #include "app/runner.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -22,8 +23,8 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-constexpr const char* energy_columns[] = {"E_kinetic", "E_bond", "E_contact", "W_external",
-                                          "E_dissipated", "E_total", "E_balance"};
+constexpr const char* energy_columns[] = {"E_kinetic",    "E_bond",     "E_contact", "W_external",
+                                          "E_dissipated", "E_fracture", "E_total",   "E_balance"};
 
 // Writes the output files of one run; every file is replaced atomically.
 class Outputs {
@@ -34,6 +35,8 @@ class Outputs {
     for (auto& c : sensor_columns(scene)) columns.push_back(c);
     for (const char* c : energy_columns) columns.push_back(c);
     if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
+    if (scene.dem.failure_enabled())
+      for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
     series_.emplace(scene.output.dir / "series.csv", columns);
     if (scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields)
       fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
@@ -55,12 +58,19 @@ class Outputs {
           values.emplace_back(names[column++], v[k]);
         }
     }
-    const double balance = e.total() + e.dissipated - e.external_work - initial_total;
-    for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.total(), balance})
+    for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture, e.total(),
+                     e.balance(initial_total)})
       row_.push_back(x);
     if (scene_.continuum) {
       row_.push_back(scene_.continuum->kinetic_energy());
       row_.push_back(scene_.continuum->strain_energy());
+    }
+    if (scene_.dem.failure_enabled()) {
+      for (const auto& set : scene_.dem.bond_sets()) {
+        const auto broken = set->broken();
+        row_.push_back(double(std::count(broken.begin(), broken.end(), 1)) / double(std::max<std::size_t>(1, set->size())));
+      }
+      write_breaks();
     }
     series_->append(row_);
     return values;
@@ -93,6 +103,23 @@ class Outputs {
     return {};
   }
 
+  // breaks.csv: one row per broken bond, rewritten (atomically) when breaks were added.
+  void write_breaks() {
+    const auto& breaks = scene_.dem.breaks();
+    if (breaks.size() == breaks_written_ && breaks_written_ > 0) return;
+    std::string text = "time,set,bond,group,criterion,mode,stress,energy\n";
+    char line[256];
+    for (const auto& e : breaks) {
+      const auto& set = *scene_.dem.bond_sets()[e.set];
+      std::snprintf(line, sizeof line, "%.12g,%u,%u,%s,%s,%s,%.9g,%.9g\n", e.time, e.set, e.bond, set.name.c_str(),
+                    std::string(dem::name_of(e.criterion)).c_str(), std::string(dem::name_of(e.mode)).c_str(), e.stress,
+                    e.energy);
+      text += line;
+    }
+    write_file_atomically(scene_.output.dir / "breaks.csv", text);
+    breaks_written_ = breaks.size();
+  }
+
   void write_particles() {
     const dem::ParticleSet& p = scene_.dem.particles;
     fields_->add_grid("particles", p.position, FieldsWriter::CellKind::Vertex, {});
@@ -104,19 +131,23 @@ class Outputs {
     fields_->add_point_field("particles", "radius", p.radius);
     scratch_int_.assign(p.groups.begin(), p.groups.end());
     fields_->add_point_field("particles", "groups", scratch_int_);
+    if (scene_.dem.failure_enabled()) fields_->add_point_field("particles", "damage", scene_.dem.damage());
     if (scene_.output.bond_fields && !scene_.dem.bond_sets().empty()) {
       scratch_lines_.clear();
       scratch_set_.clear();
+      scratch_broken_.clear();
       for (std::size_t s = 0; s < scene_.dem.bond_sets().size(); ++s) {
         const dem::BondSet& set = *scene_.dem.bond_sets()[s];
         for (std::size_t b = 0; b < set.size(); ++b) {
           scratch_lines_.push_back(set.first()[b]);
           scratch_lines_.push_back(set.second()[b]);
           scratch_set_.push_back(static_cast<std::int32_t>(s));
+          scratch_broken_.push_back(set.broken()[b]);
         }
       }
       fields_->add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, scratch_lines_);
       fields_->add_cell_field("bonds", "bond_set", scratch_set_);
+      fields_->add_cell_field("bonds", "broken", scratch_broken_);
     }
   }
 
@@ -125,7 +156,8 @@ class Outputs {
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
   std::vector<Vec3> scratch_vec_;
-  std::vector<std::int32_t> scratch_int_, scratch_set_;
+  std::vector<std::int32_t> scratch_int_, scratch_set_, scratch_broken_;
+  std::size_t breaks_written_ = 0;
   std::vector<std::int64_t> scratch_lines_;
 };
 
@@ -159,11 +191,24 @@ Json energies_json(const dem::Energies& e) {
   j["contact"] = e.contact;
   j["external_work"] = e.external_work;
   j["dissipated"] = e.dissipated;
+  j["fracture"] = e.fracture;
   j["total"] = e.total();
   return j;
 }
 
 }  // namespace
+
+const char* describe(Check::Kind kind) {
+  switch (kind) {
+    case Check::Kind::final_value: return "final value";
+    case Check::Kind::maximum: return "maximum";
+    case Check::Kind::minimum: return "minimum";
+    case Check::Kind::crossing: return "crossing time";
+  }
+  return "";
+}
+
+namespace {
 
 // Evaluates the case's checks on the rows of series.csv.
 std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const CsvSeries& series) {
@@ -172,8 +217,13 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
   for (const Check& c : scene.checks) {
     const std::size_t col = std::find(columns.begin(), columns.end(), c.column) - columns.begin();
     double value = std::numeric_limits<double>::quiet_NaN();
-    if (!c.crossing && series.rows() > 0) value = series.row(series.rows() - 1)[col];
-    for (std::size_t r = 1; c.crossing && r < series.rows(); ++r) {
+    const bool crossing = c.kind == Check::Kind::crossing;
+    if (c.kind == Check::Kind::final_value && series.rows() > 0) value = series.row(series.rows() - 1)[col];
+    for (std::size_t r = 0; (c.kind == Check::Kind::maximum || c.kind == Check::Kind::minimum) && r < series.rows(); ++r) {
+      const double x = series.row(r)[col];
+      if (r == 0 || (c.kind == Check::Kind::maximum ? x > value : x < value)) value = x;
+    }
+    for (std::size_t r = 1; crossing && r < series.rows(); ++r) {
       const double a = series.row(r - 1)[col] - c.threshold, b = series.row(r)[col] - c.threshold;
       if ((a < 0) != (b < 0) || b == 0) {  // linear interpolation of the crossing time
         const double t0 = series.row(r - 1)[0], t1 = series.row(r)[0];
@@ -186,6 +236,8 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
   }
   return out;
 }
+
+}  // namespace
 
 RunResult run_scene(Scene& scene, const RunOptions& options) {
   dem::DemModel& model = scene.dem;
@@ -259,6 +311,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["dt_critical"] = scene.dt_critical;
   Json& counts = summary["counts"];
   counts["particles"] = model.particles.size();
+  if (model.failure_enabled()) counts["broken_bonds"] = model.breaks().size();
   for (const auto& set : model.bond_sets()) counts[std::string(set->law()) + "_bonds"] = set->size();
   if (scene.continuum) scene.continuum->describe(counts);
   if (const auto* list = model.neighbours()) {
@@ -277,7 +330,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   for (const auto& c : result.checks) {
     Json j = Json::object();
     j["column"] = c.check->column;
-    j["kind"] = c.check->crossing ? "crossing time" : "final value";
+    j["kind"] = describe(c.check->kind);
     j["value"] = c.value;
     j["expected"] = c.check->expected;
     j["relative_error"] = c.relative_error;

@@ -39,4 +39,6 @@ struct RunResult {
 
 RunResult run_scene(Scene& scene, const RunOptions& options);
 
+const char* describe(Check::Kind kind);  // "final value", "maximum", ...
+
 }  // namespace arlequin::app

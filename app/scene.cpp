@@ -56,10 +56,25 @@ void read_sample(CaseNode sample, dem::ParticleSet& p, double density) {
 void read_bonds(CaseNode bond, dem::DemModel& model) {
   const double tolerance = bond.number_or("tolerance", 0.01, Range::between(0.0, 1.0), "1");
   dem::BondSet& set = model.add_bond_set(dem::make_bond_set(bond));
+  set.name = "bonds";
   bond.finish();
   for (auto [i, j] : dem::close_pairs(model.particles, tolerance)) set.add(i, j, model.particles);
   if (set.size() == 0)
     bond.fail("tolerance", "no pair of DEs is close enough to bond; raise the tolerance or remove 'bond'");
+}
+
+void read_failure(CaseNode failure, dem::DemModel& model) {
+  // BBF strengths belong to the bond laws (sigma_f, max_elongation); RDEF is per DE.
+  if (auto rdef = failure.child_if("rdef")) {
+    static constexpr std::string_view equivalents[] = {"max_principal", "von_mises"};
+    dem::DemModel::RdefSettings settings;
+    settings.threshold = rdef->number("threshold", Range::positive(), "Pa");
+    settings.von_mises = rdef->choice_or("equivalent", "max_principal", equivalents) == "von_mises";
+    settings.compaction = rdef->number_or("compaction", 0.63, Range::open_between(0.0, 1.0), "1");
+    rdef->finish();
+    model.enable_rdef(settings);
+  }
+  failure.finish();
 }
 
 void read_groups(CaseNode root, dem::DemModel& model) {
@@ -187,9 +202,16 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
       for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
       c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
     }
-    check.crossing = c.has("crossing");
-    if (check.crossing) check.threshold = c.number("crossing", Range::any(), "column unit");
-    check.expected = c.number("expected", Range::any(), check.crossing ? "s" : "column unit");
+    static constexpr std::string_view statistics[] = {"final", "max", "min"};
+    if (c.has("crossing")) {
+      check.kind = Check::Kind::crossing;
+      check.threshold = c.number("crossing", Range::any(), "column unit");
+    } else {
+      const std::string statistic = c.choice_or("statistic", "final", statistics);
+      check.kind = statistic == "final" ? Check::Kind::final_value
+                   : statistic == "max" ? Check::Kind::maximum : Check::Kind::minimum;
+    }
+    check.expected = c.number("expected", Range::any(), check.kind == Check::Kind::crossing ? "s" : "column unit");
     check.tolerance = c.number("tolerance", Range::positive(), "1");
     check.note = c.string_or("note", "");
     c.finish();
@@ -257,6 +279,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       contact->finish();
     }
     model.set_damping(dem_node->number_or("damping", 0.0, Range::non_negative(), "1/s"));
+    if (auto failure = dem_node->child_if("failure")) read_failure(*failure, model);
     dem_node->finish();
   }
   if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, options.petsc_options);
@@ -294,7 +317,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   }
   read_output(root.child_if("output"), scene, options);
   std::vector<std::string> columns = sensor_columns(scene);
-  columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_total"});
+  columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_fracture", "E_total"});
   read_checks(root, scene, columns);
   root.finish();
   scene.resolved_case = file.resolved_yaml();

@@ -9,13 +9,15 @@
 //   dem:     {sample: {build: lattice | chain | particles, ...}, density [kg/m^3],
 //             bond: {law: <bond law>, tolerance, ...law parameters},      (optional)
 //             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
-//             damping [1/s]}
+//             damping [1/s], failure: {rdef: {threshold [Pa], equivalent, compaction}}}
+//             (BBF strengths are bond-law parameters: sigma_f for beams, max_elongation for springs)
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
 //   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rotation}]
 //   initial:  [{group, velocity [m/s], angular_velocity [rad/s]}]
 //   sensors:  [{name, type: force | displacement | velocity, group, component: x | y | z | all,
 //               on: dem | continuum (default: the model the case has; dem if both)}]
-//   checks:   [{column, expected, tolerance, note} | {column, crossing: value, expected: time [s], tolerance, note}]
+//   checks:   [{column, statistic: final | max | min, expected, tolerance, note}
+//              | {column, crossing: value, expected: time [s], tolerance, note}]
 //   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s]}
 #pragma once
 #include <filesystem>
@@ -38,13 +40,14 @@ struct Sensor {
 };
 
 // An acceptance check of the case against its reference, evaluated on series.csv after the run:
-// the final value of a sensor column, or the first time a column reaches a value (a wave's
-// arrival). Relative tolerance.
+// the final, largest or smallest value of a column, or the first time a column reaches a value
+// (a wave's arrival). Relative tolerance.
 struct Check {
+  enum class Kind { final_value, maximum, minimum, crossing };
   std::string column;
-  bool crossing = false;      // else: final value
+  Kind kind = Kind::final_value;
   double threshold = 0.0;     // crossing: the value to reach
-  double expected = 0.0;      // final value, or crossing time (s)
+  double expected = 0.0;      // the value, or the crossing time (s)
   double tolerance = 0.0;     // relative
   std::string note;           // where the expected value comes from
 };

@@ -34,6 +34,7 @@ std::unique_ptr<BondSet> BeamBondSet::make(CaseNode& section) {
   prm.young = section.number("E_mu", Range::positive(), "Pa");
   prm.poisson = section.number_or("nu_mu", 0.3, Range::open_between(-1.0, 0.5), "1");
   prm.radius_ratio = section.number("r_mu", Range::open_between(0.0, 2.0), "1");
+  prm.strength = section.number_or("sigma_f", 0.0, Range::non_negative(), "Pa");
   return std::make_unique<BeamBondSet>(prm);
 }
 
@@ -49,9 +50,9 @@ void BeamBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
   const double I = 0.25 * std::numbers::pi * rb * rb * rb * rb;
   const double J = 2.0 * I;
   const double G = parameters_.young / (2.0 * (1.0 + parameters_.poisson));
-  first_.push_back(i);
-  second_.push_back(j);
+  add_pair(i, j);
   rest_length_.push_back(L0);
+  beam_radius_.push_back(rb);
   axial_.push_back(parameters_.young * S / L0);
   bending_.push_back(2.0 * parameters_.young * I / L0);
   torsion_.push_back(G * J / L0);
@@ -60,10 +61,9 @@ void BeamBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
 }
 
 void BeamBondSet::finalize(std::size_t n_particles) {
-  const auto order = colouring_.build(first_, second_, n_particles);
-  apply_order(first_, order);
-  apply_order(second_, order);
+  const auto order = order_pairs(n_particles);
   apply_order(rest_length_, order);
+  apply_order(beam_radius_, order);
   apply_order(axial_, order);
   apply_order(bending_, order);
   apply_order(torsion_, order);
@@ -114,18 +114,55 @@ void BeamBondSet::accumulate_forces(ParticleSet& p) const {
   });
 }
 
+double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
+  const double stretch = a.length - rest_length_[b];
+  return 0.5 * axial_[b] * stretch * stretch +
+         bending_[b] * (norm2(a.theta_a) + dot(a.theta_a, a.theta_b) + norm2(a.theta_b)) +
+         0.5 * torsion_[b] * a.twist * a.twist;
+}
+
+double BeamBondSet::bond_energy(std::size_t b, const ParticleSet& p) const { return energy_of(b, actions(b, p)); }
+
 double BeamBondSet::energy(const ParticleSet& p) const {
   double e = 0.0;
 #pragma omp parallel for reduction(+ : e) schedule(static) if (size() > parallel_threshold)
-  for (long bl = 0; bl < static_cast<long>(size()); ++bl) {
-    const auto b = static_cast<std::size_t>(bl);
-    const Actions a = actions(b, p);
-    const double stretch = a.length - rest_length_[b];
-    e += 0.5 * axial_[b] * stretch * stretch +
-         bending_[b] * (norm2(a.theta_a) + dot(a.theta_a, a.theta_b) + norm2(a.theta_b)) +
-         0.5 * torsion_[b] * a.twist * a.twist;
-  }
+  for (long bl = 0; bl < static_cast<long>(size()); ++bl) e += bond_energy(static_cast<std::size_t>(bl), p);
   return e;
+}
+
+void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
+                                std::vector<BreakEvent>& events) const {
+  if (!has_strength()) return;
+  const double E = parameters_.young, G = E / (2.0 * (1.0 + parameters_.poisson));
+  for (std::size_t b = 0; b < size(); ++b) {
+    if (broken_[b]) continue;
+    const Actions a = actions(b, p);
+    const double L0 = rest_length_[b], rb = beam_radius_[b];
+    const double axial = E * (a.length - L0) / L0;
+    const double bending = 2.0 * E * rb / L0 * std::max(norm(2.0 * a.theta_a + a.theta_b), norm(a.theta_a + 2.0 * a.theta_b));
+    const double sigma = axial + bending;
+    if (sigma < parameters_.strength) continue;
+    const double shear = 1.5 * E * rb * rb * norm(a.theta_a + a.theta_b) / (L0 * L0);
+    const double torsion = G * rb * std::abs(a.twist) / L0;
+    FailureMode mode = axial >= 0.0 ? FailureMode::tension : FailureMode::compression;
+    double dominant = std::abs(axial);
+    for (auto [value, m] : {std::pair{bending, FailureMode::bending}, std::pair{shear, FailureMode::shear},
+                            std::pair{torsion, FailureMode::torsion}})
+      if (value > dominant) dominant = value, mode = m;
+    events.push_back({time, set_index, static_cast<std::uint32_t>(b), FailureCriterion::bbf, mode, sigma, energy_of(b, a)});
+  }
+}
+
+void BeamBondSet::accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const {
+  for (std::size_t b = 0; b < size(); ++b) {
+    if (broken_[b]) continue;
+    const Actions a = actions(b, p);
+    // The bond pulls DE i with -force_on_j and DE j with force_on_j; r_ji = -r_ij, so both
+    // ends get the same sym(r_ij (x) f_ij).
+    const Vec3 r = p.position[second_[b]] - p.position[first_[b]];
+    add_symmetric_product(virial[first_[b]], r, -a.force_on_j);
+    add_symmetric_product(virial[second_[b]], r, -a.force_on_j);
+  }
 }
 
 void BeamBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,

@@ -21,6 +21,13 @@
 // The shear force follows from moment balance, V_j = n x (m_i + m_j) / L (magnitude
 // 6 E I (theta_a + theta_b) / L^2), so angular momentum is conserved to round-off.
 // Energy: E S (L - L0)^2 / (2 L0) + 2 E I / L0 (|ta|^2 + ta.tb + |tb|^2) + G J phi^2 / (2 L0).
+//
+// Failure (BBF, optional parameter sigma_f [Pa]): the bond breaks when its maximal normal
+// stress, sigma = N / S + r_b |M| / I at the more loaded end, reaches sigma_f. From the
+// kinematics with the nominal E (Arlequin weights do not change stresses):
+//   N / S = E (L - L0) / L0,   r_b |M_a| / I = 2 E r_b |2 theta_a + theta_b| / L0.
+// The dominant mode recorded is the largest of |N/S|, r_b|M|/I, V/S = 1.5 E r_b^2
+// |theta_a + theta_b| / L0^2 and the torsion stress G r_b |phi| / L0.
 #pragma once
 #include "dem/bond_set.hpp"
 
@@ -32,6 +39,7 @@ class BeamBondSet final : public BondSet {
     double young = 0.0;         // E_mu, Pa
     double poisson = 0.3;       // nu_mu
     double radius_ratio = 0.5;  // r_mu
+    double strength = 0.0;      // sigma_f, Pa; 0 = unbreakable
   };
   explicit BeamBondSet(const Parameters& parameters) : parameters_(parameters) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
@@ -44,6 +52,11 @@ class BeamBondSet final : public BondSet {
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
   void scale_stiffness(std::span<const double> factor) override;
+  bool has_strength() const override { return parameters_.strength > 0.0; }
+  void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
+                     std::vector<BreakEvent>& events) const override;
+  void accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const override;
+  double bond_energy(std::size_t b, const ParticleSet& p) const override;
 
   // The generalised forces of bond b in the current configuration (for tests, sensors and
   // failure criteria): forces and torques exerted by the bond on its two DEs.
@@ -56,8 +69,12 @@ class BeamBondSet final : public BondSet {
   const Parameters& parameters() const { return parameters_; }
 
  private:
+  void zero_stiffness(std::size_t b) override { axial_[b] = bending_[b] = torsion_[b] = 0.0; }
+  double energy_of(std::size_t b, const Actions& a) const;
+
   Parameters parameters_;
   std::vector<double> rest_length_;   // L0, m
+  std::vector<double> beam_radius_;   // r_b, m
   std::vector<double> axial_;         // E S / L0, N/m
   std::vector<double> bending_;       // 2 E I / L0, N m
   std::vector<double> torsion_;       // G J / L0, N m

@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "dem/failure.hpp"
 #include "dem/particles.hpp"
 
 namespace arlequin {
@@ -72,12 +73,45 @@ class BondSet {
   // set-up, so the force loop pays nothing for it.
   virtual void scale_stiffness(std::span<const double> factor) = 0;
 
+  // Failure. has_strength(): the law was given a strength, so find_failures() can report
+  // events (BBF for beams, maximum elongation for springs). accumulate_virial() adds
+  // sym(r_ij (x) f_ij) of every intact bond to both its DEs (RDEF, see failure.hpp).
+  virtual bool has_strength() const = 0;
+  virtual void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
+                             std::vector<BreakEvent>& events) const = 0;
+  virtual void accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const = 0;
+  virtual double bond_energy(std::size_t b, const ParticleSet& p) const = 0;
+  // A broken bond keeps its place but its stiffness is zero: it carries no force from the
+  // next force evaluation on, and the force loop needs no branch for it.
+  void break_bond(std::size_t b) {
+    broken_[b] = 1;
+    zero_stiffness(b);
+  }
+  std::span<const std::uint8_t> broken() const { return broken_; }
+
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }
   std::span<const std::uint32_t> second() const { return second_; }
+  std::string name;  // the bonds' group (e.g. fibre, matrix, interface), for records and output
 
  protected:
+  void add_pair(std::uint32_t i, std::uint32_t j) {
+    first_.push_back(i);
+    second_.push_back(j);
+    broken_.push_back(0);
+  }
+  // Colours the pairs and reorders first/second/broken; returns the order for the law's arrays.
+  std::vector<std::uint32_t> order_pairs(std::size_t n_particles) {
+    auto order = colouring_.build(first_, second_, n_particles);
+    apply_order(first_, order);
+    apply_order(second_, order);
+    apply_order(broken_, order);
+    return order;
+  }
+  virtual void zero_stiffness(std::size_t b) = 0;
+
   std::vector<std::uint32_t> first_, second_;
+  std::vector<std::uint8_t> broken_;
   BondColouring colouring_;
 };
 

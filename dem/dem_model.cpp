@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -70,14 +71,19 @@ void DemModel::finalize() {
     }
   }
   constraint_reaction_.assign(constraints_.size(), Vec3{});
+  driven_.assign(particles.size(), 0);
+  for (const Constraint& c : constraints_) driven_[c.particle] = 1;
+  if (damping_ > 0.0) {
+    damping_force_.assign(particles.size(), Vec3{});
+    damping_torque_.assign(particles.size(), Vec3{});
+  }
   for (auto& set : bond_sets_) set->finalize(particles.size());
   if (neighbours_) {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> bonded;
-    for (const auto& set : bond_sets_)
-      for (std::size_t b = 0; b < set->size(); ++b) bonded.emplace_back(set->first()[b], set->second()[b]);
-    neighbours_->set_exclusions(std::move(bonded));
+    neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
+  failure_on_ = rdef_.has_value() ||
+                std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
   compute_forces();
   record_reactions();
   apply_loads_and_damping();
@@ -117,6 +123,7 @@ void DemModel::advance_to_forces(double dt) {
   time_ += dt;
   update_neighbours();                // only with contact, only when a DE moved > skin/2
   compute_forces();                   // bonds, contacts -> f(n+1)
+  if (failure_on_) apply_failures();  // BBF / RDEF: break bonds, forces again if any broke
   record_reactions();                 // for sensors, and the work of driven DEs
   apply_loads_and_damping();          // dead loads, viscous damping
 }
@@ -143,11 +150,20 @@ void DemModel::apply_arlequin_weight(const std::function<double(const Vec3&)>& a
 void DemModel::kick(double half_dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-#pragma omp parallel for schedule(static) if (n > parallel_threshold)
+  // A half kick changes a DE's kinetic energy by h F . (v + v')/2 exactly; the damping
+  // force's share of that is the energy it dissipated.
+  double damped = 0.0;
+  const bool damping = damping_ > 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : damped) if (n > parallel_threshold)
   for (long i = 0; i < n; ++i) {
+    const Vec3 v = p.velocity[i], w = p.angular_velocity[i];
     p.velocity[i] += p.force[i] * (half_dt * p.inv_mass[i]);
     p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia(i));
+    if (damping)
+      damped -= half_dt * (dot(damping_force_[i], 0.5 * (v + p.velocity[i])) +
+                           dot(damping_torque_[i], 0.5 * (w + p.angular_velocity[i])));
   }
+  dissipated_ += damped;
 }
 
 void DemModel::impose_motion(double t, bool half_step, double dt) {
@@ -187,6 +203,77 @@ void DemModel::compute_forces() {
   if (contact_) contact_->accumulate_forces(*neighbours_, particles);
 }
 
+std::vector<std::pair<std::uint32_t, std::uint32_t>> DemModel::intact_bonded_pairs() const {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (const auto& set : bond_sets_)
+    for (std::size_t b = 0; b < set->size(); ++b)
+      if (!set->broken()[b]) pairs.emplace_back(set->first()[b], set->second()[b]);
+  return pairs;
+}
+
+void DemModel::apply_failures() {
+  new_breaks_.clear();
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s)
+    bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
+  if (rdef_) {
+    const ParticleSet& p = particles;
+    const std::vector<Sym3> sigma = virial_stress(rdef_->compaction);
+    std::vector<char> failed(p.size(), 0);
+    std::vector<double> equivalent(p.size(), 0.0);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      equivalent[i] = rdef_->von_mises ? von_mises(sigma[i]) : max_principal(sigma[i]);
+      failed[i] = equivalent[i] >= rdef_->threshold;
+    }
+    for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+      const BondSet& set = *bond_sets_[s];
+      for (std::size_t b = 0; b < set.size(); ++b) {
+        const std::uint32_t i = set.first()[b], j = set.second()[b];
+        if (set.broken()[b] || !(failed[i] || failed[j])) continue;
+        new_breaks_.push_back({time_, static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(b), FailureCriterion::rdef,
+                               FailureMode::tension, std::max(failed[i] ? equivalent[i] : 0.0, failed[j] ? equivalent[j] : 0.0),
+                               set.bond_energy(b, p)});
+      }
+    }
+  }
+  if (new_breaks_.empty()) return;
+  for (const BreakEvent& e : new_breaks_) {
+    BondSet& set = *bond_sets_[e.set];
+    if (set.broken()[e.bond]) continue;  // reported twice (BBF and RDEF): break once
+    set.break_bond(e.bond);
+    fracture_ += e.energy;
+    breaks_.push_back(e);
+  }
+  // Former partners now meet by contact; the step's forces are recomputed without the bonds.
+  if (neighbours_) {
+    neighbours_->set_exclusions(intact_bonded_pairs());
+    neighbours_->build(particles);
+  }
+  compute_forces();
+}
+
+std::vector<Sym3> DemModel::virial_stress(double compaction) const {
+  std::vector<Sym3> sigma(particles.size(), Sym3{});
+  for (const auto& set : bond_sets_) set->accumulate_virial(particles, sigma);
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij), Omega_i = (4/3 pi R^3) / compaction.
+    const double omega = 4.0 / 3.0 * std::numbers::pi * std::pow(particles.radius[i], 3) / compaction;
+    for (double& c : sigma[i]) c /= 2.0 * omega;
+  }
+  return sigma;
+}
+
+std::vector<double> DemModel::damage() const {
+  std::vector<double> bonds(particles.size(), 0.0), broken(particles.size(), 0.0);
+  for (const auto& set : bond_sets_)
+    for (std::size_t b = 0; b < set->size(); ++b)
+      for (std::uint32_t i : {set->first()[b], set->second()[b]}) {
+        bonds[i] += 1.0;
+        broken[i] += set->broken()[b];
+      }
+  for (std::size_t i = 0; i < bonds.size(); ++i) broken[i] = bonds[i] > 0.0 ? broken[i] / bonds[i] : 0.0;
+  return broken;
+}
+
 void DemModel::record_reactions() {
   const ParticleSet& p = particles;
   if (watched_) {
@@ -213,14 +300,13 @@ void DemModel::apply_loads_and_damping() {
     external_work_ += dot(load_per_particle_[k], p.velocity[i]) * last_dt_;
   }
   if (damping_ > 0.0) {
-    double power = 0.0;
+    // Viscous damping from the half-step velocity, none on driven DEs (their motion is imposed).
     for (std::size_t i = 0; i < p.size(); ++i) {
-      const double m = p.mass(i), inertia = p.inertia(i);
-      p.force[i] -= p.velocity[i] * (damping_ * m);
-      p.torque[i] -= p.angular_velocity[i] * (damping_ * inertia);
-      power += damping_ * (m * norm2(p.velocity[i]) + inertia * norm2(p.angular_velocity[i]));
+      damping_force_[i] = driven_[i] ? Vec3{} : p.velocity[i] * (-damping_ * p.mass(i));
+      damping_torque_[i] = driven_[i] ? Vec3{} : p.angular_velocity[i] * (-damping_ * p.inertia(i));
+      p.force[i] += damping_force_[i];
+      p.torque[i] += damping_torque_[i];
     }
-    dissipated_ += power * last_dt_;
   }
 }
 
@@ -233,6 +319,7 @@ Energies DemModel::energies() const {
   if (contact_) e.contact = contact_->energy(*neighbours_, p);
   e.external_work = external_work_;
   e.dissipated = dissipated_;
+  e.fracture = fracture_;
   return e;
 }
 

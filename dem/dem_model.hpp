@@ -16,6 +16,7 @@
 #include "dem/bond_set.hpp"
 #include "dem/boundary.hpp"
 #include "dem/contact_law.hpp"
+#include "dem/failure.hpp"
 #include "dem/neighbour_list.hpp"
 #include "dem/particles.hpp"
 
@@ -27,7 +28,10 @@ struct Energies {
   double contact = 0.0;        // elastic energy in contacts, J
   double external_work = 0.0;  // work done on the model by boundary conditions and loads, J
   double dissipated = 0.0;     // by viscous damping, J
+  double fracture = 0.0;       // elastic energy of bonds when they broke, J
   double total() const { return kinetic + bond + contact; }
+  // Zero for an exact run: what is stored plus what was lost, less the work put in.
+  double balance(double initial_total) const { return total() + dissipated + fracture - external_work - initial_total; }
 };
 
 class DemModel {
@@ -57,6 +61,15 @@ class DemModel {
   // weighted (a coupled zone is bonded).
   void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
 
+  // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
+  // stress reaches `threshold`; Omega_i = sphere volume / compaction.
+  struct RdefSettings {
+    double threshold = 0.0;   // Pa
+    bool von_mises = false;   // else the maximal principal stress
+    double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
+  };
+  void enable_rdef(const RdefSettings& settings) { rdef_ = settings; }
+
   void finalize();
 
   // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
@@ -72,6 +85,15 @@ class DemModel {
   void finish_step(double dt);        // kick dt/2 to the velocities at t + dt
   double time() const { return time_; }
   long steps_done() const { return steps_; }
+
+  // Every break so far, in order; broken bonds' energy is in Energies::fracture.
+  const std::vector<BreakEvent>& breaks() const { return breaks_; }
+  bool failure_enabled() const { return failure_on_; }
+  // Virial stress of every DE over its intact bonds (failure.hpp, seed Eq. 1), Pa, with the
+  // volume share Omega_i = sphere volume / compaction.
+  std::vector<Sym3> virial_stress(double compaction) const;
+  // Fraction of each DE's bonds that are broken (0 for a DE without bonds).
+  std::vector<double> damage() const;
 
   Energies energies() const;
   double external_work() const { return external_work_; }  // J, cheap (no energy sums)
@@ -94,6 +116,8 @@ class DemModel {
   void update_neighbours();
   void compute_forces();
   void record_reactions();
+  void apply_failures();
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;
   void apply_loads_and_damping();
 
@@ -110,14 +134,21 @@ class DemModel {
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
   std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
+  std::optional<RdefSettings> rdef_;
+  bool failure_on_ = false;              // a law has a strength, or RDEF is on
+  std::vector<BreakEvent> breaks_;
+  std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   GroupMask watched_ = 0;
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;
+  std::vector<Vec3> damping_force_, damping_torque_;  // this step's, kept for both half kicks
+  std::vector<char> driven_;                          // per DE: its motion is imposed
   double time_ = 0.0;
   double last_dt_ = 0.0;  // s, step size of the step in progress (0 before the first)
   long steps_ = 0;
   double external_work_ = 0.0;
   double dissipated_ = 0.0;
+  double fracture_ = 0.0;
 };
 
 }  // namespace arlequin::dem

@@ -7,12 +7,12 @@
 namespace arlequin::dem {
 
 std::unique_ptr<BondSet> SpringBondSet::make(CaseNode& section) {
-  return std::make_unique<SpringBondSet>(section.number("stiffness", Range::positive(), "N/m"));
+  const double stiffness = section.number("stiffness", Range::positive(), "N/m");
+  return std::make_unique<SpringBondSet>(stiffness, section.number_or("max_elongation", 0.0, Range::non_negative(), "1"));
 }
 
 void SpringBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
-  first_.push_back(i);
-  second_.push_back(j);
+  add_pair(i, j);
   rest_length_.push_back(norm(p.position[j] - p.position[i]));
   stiffness_.push_back(nominal_stiffness_);
 }
@@ -22,31 +22,56 @@ void SpringBondSet::scale_stiffness(std::span<const double> factor) {
 }
 
 void SpringBondSet::finalize(std::size_t n_particles) {
-  const auto order = colouring_.build(first_, second_, n_particles);
-  apply_order(first_, order);
-  apply_order(second_, order);
+  const auto order = order_pairs(n_particles);
   apply_order(rest_length_, order);
   apply_order(stiffness_, order);
 }
 
+Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const {
+  const Vec3 d = p.position[second_[b]] - p.position[first_[b]];
+  const double L = norm(d);
+  return d * (-stiffness_[b] * (L - rest_length_[b]) / L);
+}
+
 void SpringBondSet::accumulate_forces(ParticleSet& p) const {
   for_each_bond(colouring_, [&](std::size_t b) {
-    const std::uint32_t i = first_[b], j = second_[b];
-    const Vec3 d = p.position[j] - p.position[i];
-    const double L = norm(d);
-    const Vec3 f_j = d * (-stiffness_[b] * (L - rest_length_[b]) / L);
-    p.force[i] -= f_j;
-    p.force[j] += f_j;
+    const Vec3 f_j = force_on_j(b, p);
+    p.force[first_[b]] -= f_j;
+    p.force[second_[b]] += f_j;
   });
+}
+
+double SpringBondSet::bond_energy(std::size_t b, const ParticleSet& p) const {
+  const double stretch = norm(p.position[second_[b]] - p.position[first_[b]]) - rest_length_[b];
+  return 0.5 * stiffness_[b] * stretch * stretch;
 }
 
 double SpringBondSet::energy(const ParticleSet& p) const {
   double e = 0.0;
-  for (std::size_t b = 0; b < size(); ++b) {
-    const double stretch = norm(p.position[second_[b]] - p.position[first_[b]]) - rest_length_[b];
-    e += 0.5 * stiffness_[b] * stretch * stretch;
-  }
+  for (std::size_t b = 0; b < size(); ++b) e += bond_energy(b, p);
   return e;
+}
+
+void SpringBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
+                                  std::vector<BreakEvent>& events) const {
+  if (!has_strength()) return;
+  for (std::size_t b = 0; b < size(); ++b) {
+    if (broken_[b]) continue;
+    const double elongation = norm(p.position[second_[b]] - p.position[first_[b]]) / rest_length_[b] - 1.0;
+    if (elongation >= max_elongation_)
+      events.push_back({time, set_index, static_cast<std::uint32_t>(b), FailureCriterion::elongation,
+                        FailureMode::tension, elongation, bond_energy(b, p)});
+  }
+}
+
+void SpringBondSet::accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const {
+  for (std::size_t b = 0; b < size(); ++b) {
+    if (broken_[b]) continue;
+    const Vec3 r = p.position[second_[b]] - p.position[first_[b]];
+    const Vec3 f_i = -force_on_j(b, p);
+    add_symmetric_product(virial[first_[b]], r, f_i);
+    add_symmetric_product(virial[second_[b]], r, f_i);
+  }
 }
 
 void SpringBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,

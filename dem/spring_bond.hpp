@@ -5,6 +5,8 @@
 //   stiffness  K [N/m]. For a yarn discretised with n_p DEs per n_s springs, seed Eq. 8 gives
 //              K_mu = (n_s / n_p) K_M from the yarn's macroscopic stiffness K_M.
 // Central force: no torque, so rotations of the DEs are untouched.
+// Failure (optional parameter max_elongation [1]): the spring breaks when (|d| - L0) / L0
+// reaches it (elastic-brittle yarn).
 #pragma once
 #include "dem/bond_set.hpp"
 
@@ -12,7 +14,8 @@ namespace arlequin::dem {
 
 class SpringBondSet final : public BondSet {
  public:
-  explicit SpringBondSet(double stiffness) : nominal_stiffness_(stiffness) {}
+  SpringBondSet(double stiffness, double max_elongation = 0.0)
+      : nominal_stiffness_(stiffness), max_elongation_(max_elongation) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
 
   std::string_view law() const override { return "spring"; }
@@ -23,9 +26,18 @@ class SpringBondSet final : public BondSet {
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
   void scale_stiffness(std::span<const double> factor) override;
+  bool has_strength() const override { return max_elongation_ > 0.0; }
+  void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
+                     std::vector<BreakEvent>& events) const override;
+  void accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const override;
+  double bond_energy(std::size_t b, const ParticleSet& p) const override;
 
  private:
+  void zero_stiffness(std::size_t b) override { stiffness_[b] = 0.0; }
+  Vec3 force_on_j(std::size_t b, const ParticleSet& p) const;
+
   double nominal_stiffness_;         // K of the case file, N/m
+  double max_elongation_;            // 0 = unbreakable
   std::vector<double> stiffness_;    // K per bond (weighted), N/m
   std::vector<double> rest_length_;  // L0, m
 };

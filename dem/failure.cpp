@@ -1,0 +1,49 @@
+#include "dem/failure.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace arlequin::dem {
+
+double max_principal(const Sym3& t) {
+  // Eigenvalues of a symmetric 3x3 matrix: Smith's trigonometric form (CACM 4 (1961) 168).
+  const double p1 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5];
+  const double q = (t[0] + t[1] + t[2]) / 3.0;
+  if (p1 == 0.0) return std::max({t[0], t[1], t[2]});
+  const double p2 = (t[0] - q) * (t[0] - q) + (t[1] - q) * (t[1] - q) + (t[2] - q) * (t[2] - q) + 2.0 * p1;
+  const double p = std::sqrt(p2 / 6.0);
+  // B = (A - q I) / p; r = det(B) / 2, clamped to [-1, 1] against round-off.
+  const double b0 = (t[0] - q) / p, b1 = (t[1] - q) / p, b2 = (t[2] - q) / p;
+  const double b3 = t[3] / p, b4 = t[4] / p, b5 = t[5] / p;
+  const double det = b0 * (b1 * b2 - b3 * b3) - b5 * (b5 * b2 - b3 * b4) + b4 * (b5 * b3 - b1 * b4);
+  const double r = std::clamp(0.5 * det, -1.0, 1.0);
+  return q + 2.0 * p * std::cos(std::acos(r) / 3.0);
+}
+
+double von_mises(const Sym3& t) {
+  const double d01 = t[0] - t[1], d12 = t[1] - t[2], d20 = t[2] - t[0];
+  return std::sqrt(0.5 * (d01 * d01 + d12 * d12 + d20 * d20) + 3.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]));
+}
+
+std::string_view name_of(FailureCriterion c) {
+  switch (c) {
+    case FailureCriterion::bbf: return "bbf";
+    case FailureCriterion::elongation: return "elongation";
+    case FailureCriterion::rdef: return "rdef";
+  }
+  return "";
+}
+
+std::string_view name_of(FailureMode m) {
+  switch (m) {
+    case FailureMode::tension: return "tension";
+    case FailureMode::compression: return "compression";
+    case FailureMode::bending: return "bending";
+    case FailureMode::shear: return "shear";
+    case FailureMode::torsion: return "torsion";
+  }
+  return "";
+}
+
+}  // namespace arlequin::dem

@@ -1,0 +1,52 @@
+// Bond failure: events, the virial stress of a DE, and the RDEF criterion.
+//
+// BBF (breakable bond): each bond law judges its own bonds (beam: maximal normal stress,
+// N/S + r_b |M| / I over both ends, reaching sigma_f; spring: elongation reaching its maximum).
+// RDEF (seed paper Eq. 1): the virial stress of DE i over its intact bonds,
+//   sigma_i = 1 / (2 Omega_i) sum_j 1/2 (r_ij (x) f_ij + f_ij (x) r_ij),
+// r_ij = x_j - x_i, f_ij the force of the bond on DE i (towards j in tension, so tension is
+// positive), Omega_i the DE's volume share (sphere volume / compaction, so the shares add up to
+// the sample volume). When its equivalent stress reaches the threshold, every bond of the DE
+// breaks; the DE stays and interacts by contact.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+#include "common/vec3.hpp"
+
+namespace arlequin::dem {
+
+// Symmetric 3x3 tensor, Voigt order xx, yy, zz, yz, xz, xy.
+using Sym3 = std::array<double, 6>;
+
+// Adds sym(a (x) b) to t.
+inline void add_symmetric_product(Sym3& t, const Vec3& a, const Vec3& b) {
+  t[0] += a.x * b.x;
+  t[1] += a.y * b.y;
+  t[2] += a.z * b.z;
+  t[3] += 0.5 * (a.y * b.z + a.z * b.y);
+  t[4] += 0.5 * (a.x * b.z + a.z * b.x);
+  t[5] += 0.5 * (a.x * b.y + a.y * b.x);
+}
+
+// Largest eigenvalue of a symmetric tensor (closed form, trigonometric).
+double max_principal(const Sym3& t);
+double von_mises(const Sym3& t);
+
+enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef };
+enum class FailureMode : std::uint8_t { tension, compression, bending, shear, torsion };
+std::string_view name_of(FailureCriterion c);
+std::string_view name_of(FailureMode m);
+
+struct BreakEvent {
+  double time = 0.0;          // s
+  std::uint32_t set = 0;      // index of the bond set
+  std::uint32_t bond = 0;     // index in the set
+  FailureCriterion criterion = FailureCriterion::bbf;
+  FailureMode mode = FailureMode::tension;  // dominant stress at break
+  double stress = 0.0;        // criterion value at break (Pa, or elongation for springs)
+  double energy = 0.0;        // elastic energy the bond held, now dissipated (J)
+};
+
+}  // namespace arlequin::dem

@@ -1,0 +1,160 @@
+// Bond failure against closed forms: BBF thresholds in pure tension and pure bending, springs at
+// their maximum elongation, no force after a break, the RDEF virial stress of a uniformly
+// strained lattice, RDEF breaking every bond of a DE, and contact between former partners.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "dem/penalty_contact.hpp"
+#include "dem/spring_bond.hpp"
+#include "support/dem_fixtures.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+using test::R1Beam;
+
+struct BreakablePair : ::testing::Test {
+  static constexpr double sigma_f = 200.0;  // N/mm^2 (R1 units)
+  ParticleSet p;
+  BeamBondSet beam{{R1Beam::E, R1Beam::nu, R1Beam::r_mu, sigma_f}};
+  void SetUp() override {
+    p.add({0, 0, 0}, R1Beam::R, 1.0);
+    p.add({R1Beam::L, 0, 0}, R1Beam::R, 1.0);
+    beam.add(0, 1, p);
+    beam.finalize(2);
+  }
+  std::vector<BreakEvent> failures() const {
+    std::vector<BreakEvent> events;
+    beam.find_failures(p, 0, 0.0, events);
+    return events;
+  }
+};
+
+TEST_F(BreakablePair, BreaksExactlyAtTheThresholdInPureTension) {
+  // N / S = E (L - L0) / L0 = sigma_f at L - L0 = sigma_f L0 / E.
+  const double critical = sigma_f * R1Beam::L / R1Beam::E;
+  p.position[1].x = R1Beam::L + critical * (1.0 - 1e-9);
+  EXPECT_TRUE(failures().empty());
+  p.position[1].x = R1Beam::L + critical * (1.0 + 1e-9);
+  const auto events = failures();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].mode, FailureMode::tension);
+  EXPECT_NEAR(events[0].stress, sigma_f, 1e-6 * sigma_f);
+  // Its energy is the axial spring's: E S / L0 (dL)^2 / 2.
+  EXPECT_NEAR(events[0].energy, 0.5 * R1Beam::E * R1Beam::S / R1Beam::L * critical * critical, 1e-6 * events[0].energy);
+}
+
+TEST_F(BreakablePair, BreaksExactlyAtTheThresholdInPureBending) {
+  // DE i turned by t, j fixed: M_a = 2EI/L (2t), r_b M_a / I = 4 E r_b t / L = sigma_f.
+  const double critical = sigma_f * R1Beam::L / (4.0 * R1Beam::E * R1Beam::rb);
+  p.orientation[0] = from_rotation_vector({0, 0, critical * (1.0 - 1e-9)});
+  EXPECT_TRUE(failures().empty());
+  p.orientation[0] = from_rotation_vector({0, 0, critical * (1.0 + 1e-9)});
+  const auto events = failures();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].mode, FailureMode::bending);
+}
+
+TEST_F(BreakablePair, ABrokenBondCarriesNoForce) {
+  p.position[1] = {R1Beam::L + 0.01, 0.02, -0.01};
+  p.orientation[0] = from_rotation_vector({0.01, 0.0, 0.02});
+  beam.break_bond(0);
+  p.clear_forces();
+  beam.accumulate_forces(p);
+  EXPECT_EQ(norm(p.force[0]) + norm(p.force[1]) + norm(p.torque[0]) + norm(p.torque[1]), 0.0);
+  EXPECT_EQ(beam.energy(p), 0.0);
+  EXPECT_TRUE(failures().empty());  // broken once, never reported again
+}
+
+TEST(SpringFailure, BreaksAtTheMaximumElongation) {
+  ParticleSet p;
+  p.add({0, 0, 0}, 1.0, 1.0);
+  p.add({2, 0, 0}, 1.0, 1.0);
+  SpringBondSet spring(100.0, 0.05);
+  spring.add(0, 1, p);
+  spring.finalize(2);
+  std::vector<BreakEvent> events;
+  p.position[1].x = 2.0 * (1.05 - 1e-9);
+  spring.find_failures(p, 0, 0.0, events);
+  EXPECT_TRUE(events.empty());
+  p.position[1].x = 2.0 * (1.05 + 1e-9);
+  spring.find_failures(p, 0, 0.0, events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].criterion, FailureCriterion::elongation);
+}
+
+// A simple-cubic lattice (spacing a, compaction pi/6) stretched uniformly by eps along x: each
+// x-bond carries N = E S eps, so the applied stress is sigma_xx = N / a^2 and the other
+// components vanish. The virial stress of an interior DE must equal it (2 %).
+TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
+  DemModel model;
+  const double R = 1e-3, a = 2 * R, eps = 1e-4, E = 2e11;
+  build_lattice(model.particles, {0, 0, 0}, {5, 5, 5}, a, R, 7800.0);
+  test::bond_all_touching(model, {E, 0.3, 0.5});
+  model.finalize();
+  for (auto& x : model.particles.position) x.x *= 1.0 + eps;
+  const auto sigma = model.virial_stress(std::numbers::pi / 6.0);
+  const double S = std::numbers::pi * 0.25 * R * R;
+  const double applied = E * S * eps / (a * a);
+  const std::size_t centre = 2 + 5 * (2 + 5 * 2);
+  EXPECT_NEAR(sigma[centre][0], applied, 0.02 * applied);
+  for (int c = 1; c < 6; ++c) EXPECT_NEAR(sigma[centre][c], 0.0, 1e-9 * applied);
+  EXPECT_NEAR(max_principal(sigma[centre]), sigma[centre][0], 1e-9 * applied);
+}
+
+TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
+  DemModel model;
+  const double R = 1e-3;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
+  test::bond_all_touching(model, {2e11, 0.3, 0.5});
+  // DE 2 carries 2.36e7 Pa (both bonds stretched 1e-6 m), DEs 1 and 3 half of it.
+  model.enable_rdef({1.8e7, false, 0.63});
+  model.finalize();
+  // Stretch the middle DE's two bonds only: move DEs 3 and 4 right, 0 and 1 left.
+  for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
+  for (std::size_t i : {3u, 4u}) model.particles.position[i].x += 1e-6;
+  const double stored = model.energies().bond;
+  model.step(1e-12);
+  const auto& breaks = model.breaks();
+  ASSERT_EQ(breaks.size(), 2u);
+  for (const auto& e : breaks) {
+    EXPECT_EQ(e.criterion, FailureCriterion::rdef);
+    const auto& set = *model.bond_sets()[e.set];
+    EXPECT_TRUE(set.first()[e.bond] == 2 || set.second()[e.bond] == 2);
+  }
+  EXPECT_NEAR(model.damage()[2], 1.0, 0.0);
+  EXPECT_NEAR(model.energies().fracture, stored, 1e-6 * stored);
+}
+
+// Two DEs bonded by a weak beam are pulled apart until it breaks; sent back towards each other,
+// they meet by penalty contact and bounce elastically.
+TEST(Failure, FormerPartnersInteractByContact) {
+  DemModel model;
+  const double R = 1e-3;
+  model.particles.add({0, 0, 0}, R, 7800.0);
+  model.particles.add({2 * R, 0, 0}, R, 7800.0);
+  test::bond_all_touching(model, {2e11, 0.3, 0.5, 1e6});
+  model.set_contact(std::make_unique<PenaltyContact>(1e6), 0.2 * R);
+  model.particles.velocity[0] = {-0.5, 0, 0};
+  model.particles.velocity[1] = {0.5, 0, 0};
+  model.finalize();
+  const double dt = 0.05 * model.critical_time_step();
+  while (model.breaks().empty()) model.step(dt);
+  EXPECT_EQ(model.breaks()[0].criterion, FailureCriterion::bbf);
+  for (int n = 0; n < 200; ++n) model.step(dt);
+  model.particles.velocity[0] = {1.0, 0, 0};
+  model.particles.velocity[1] = {-1.0, 0, 0};
+  double max_contact = 0.0, contact = 0.0;
+  for (int n = 0; n < 20000 && (max_contact == 0.0 || contact > 0.0); ++n) {  // until they part again
+    model.step(dt);
+    contact = model.energies().contact;
+    max_contact = std::max(max_contact, contact);
+  }
+  EXPECT_GT(max_contact, 0.0);
+  EXPECT_LT(model.particles.velocity[0].x, 0.0);  // bounced back
+  EXPECT_NEAR(model.particles.velocity[0].x, -1.0, 0.01);
+}
+
+}  // namespace
+}  // namespace arlequin::dem
