@@ -113,7 +113,8 @@ Arguments parse(int argc, char** argv) {
 void print_scene_facts(const app::Scene& scene) {
   const auto& model = scene.dem;
   std::printf("case: %s\n  DEs: %zu\n", scene.name.c_str(), model.particles.size());
-  for (const auto& set : model.bond_sets()) std::printf("  %s bonds: %zu\n", std::string(set->law()).c_str(), set->size());
+  for (const auto& set : model.bond_sets())
+    std::printf("  %s bonds (%s): %zu\n", set->name.c_str(), std::string(set->law()).c_str(), set->size());
   if (model.particles.size() > 0)
     std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
   if (scene.continuum) {

@@ -312,7 +312,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Json& counts = summary["counts"];
   counts["particles"] = model.particles.size();
   if (model.failure_enabled()) counts["broken_bonds"] = model.breaks().size();
-  for (const auto& set : model.bond_sets()) counts[std::string(set->law()) + "_bonds"] = set->size();
+  if (!model.bond_sets().empty()) {
+    Json& bonds = counts["bonds"];
+    for (const auto& set : model.bond_sets()) bonds[set->name] = set->size();
+  }
   if (scene.continuum) scene.continuum->describe(counts);
   if (const auto* list = model.neighbours()) {
     counts["contact_candidates"] = list->pairs().size();

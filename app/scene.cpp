@@ -63,6 +63,81 @@ void read_bonds(CaseNode bond, dem::DemModel& model) {
     bond.fail("tolerance", "no pair of DEs is close enough to bond; raise the tolerance or remove 'bond'");
 }
 
+// Several materials (e.g. a fibre cylinder in a matrix cube): each DE takes the first material
+// whose region holds it, or the one material without a region; it gets that material's density
+// and a group named after it. A bond between two DEs of one material uses that material's bond
+// law and parameters; a bond across materials uses dem.interface. Bond sets are named after
+// their material (and "interface"), so records and outputs say fibre, matrix, interface.
+void read_materials(CaseNode dem_node, dem::DemModel& model) {
+  CaseNode materials = dem_node.child("materials");
+  struct Material {
+    std::string name;
+    std::optional<Region> region;
+    double density;
+    std::optional<CaseNode> bond;
+  };
+  std::vector<Material> list;
+  int fallback = -1;
+  for (const std::string& name : materials.keys()) {
+    CaseNode m = materials.child_named(name);
+    Material mat{name, std::nullopt, m.number("density", Range::positive(), "kg/m^3"), m.child_if("bond")};
+    if (auto region = m.child_if("region")) {
+      mat.region = Region::read(*region);
+      region->finish();
+    } else if (fallback >= 0) {
+      m.fail("region", "only one material may go without a region (the rest of the sample); '" +
+                           list[fallback].name + "' already does");
+    } else {
+      fallback = int(list.size());
+    }
+    list.push_back(mat);
+  }
+  if (list.empty()) dem_node.fail("materials", "expected at least one material");
+  // Regions first, in file order; the region-less material takes the rest.
+  dem::ParticleSet& p = model.particles;
+  std::vector<int> material_of(p.size(), -1);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t m = 0; m < list.size() && material_of[i] < 0; ++m)
+      if (list[m].region && list[m].region->contains(p.position[i])) material_of[i] = int(m);
+    if (material_of[i] < 0) material_of[i] = fallback;
+    if (material_of[i] < 0) {
+      std::ostringstream msg;
+      msg << "DE " << i << " at (" << p.position[i].x << ", " << p.position[i].y << ", " << p.position[i].z
+          << ") m is in no material's region; give one material no region to take the rest";
+      dem_node.fail("materials", msg.str());
+    }
+    // The sample was built with unit density: scale the mass to the material's.
+    p.inv_mass[i] /= list[material_of[i]].density;
+  }
+  std::vector<int> group(list.size());
+  for (std::size_t m = 0; m < list.size(); ++m) group[m] = model.add_group(list[m].name);
+  for (std::size_t i = 0; i < p.size(); ++i) p.groups[i] |= dem::GroupMask{1} << group[material_of[i]];
+
+  // One bond set per material with a bond law, and one for the interfaces.
+  const double tolerance = dem_node.number_or("bond_tolerance", 0.01, Range::between(0.0, 1.0), "1");
+  std::vector<dem::BondSet*> set_of(list.size(), nullptr);
+  for (std::size_t m = 0; m < list.size(); ++m) {
+    if (!list[m].bond) continue;
+    set_of[m] = &model.add_bond_set(dem::make_bond_set(*list[m].bond));
+    set_of[m]->name = list[m].name;
+    list[m].bond->finish();
+  }
+  dem::BondSet* interface = nullptr;
+  if (auto section = dem_node.child_if("interface")) {
+    CaseNode bond = section->child("bond");
+    interface = &model.add_bond_set(dem::make_bond_set(bond));
+    interface->name = "interface";
+    bond.finish();
+    section->finish();
+  }
+  for (auto [i, j] : dem::close_pairs(p, tolerance)) {
+    const int a = material_of[i], b = material_of[j];
+    dem::BondSet* set = a == b ? set_of[a] : interface;
+    if (set) set->add(i, j, p);
+  }
+  for (std::size_t m = 0; m < list.size(); ++m) materials.child_named(list[m].name).finish();
+}
+
 void read_failure(CaseNode failure, dem::DemModel& model) {
   // BBF strengths belong to the bond laws (sigma_f, max_elongation); RDEF is per DE.
   if (auto rdef = failure.child_if("rdef")) {
@@ -267,9 +342,17 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (!dem_node && !continuum_node) root.fail("dem", "a case needs a dem section, a continuum section, or both");
   dem::DemModel& model = scene.dem;
   if (dem_node) {
-    const double density = dem_node->number("density", Range::positive(), "kg/m^3");
-    read_sample(dem_node->child("sample"), model.particles, density);
-    if (auto bond = dem_node->child_if("bond")) read_bonds(*bond, model);
+    if (dem_node->has("materials")) {
+      for (const char* single : {"density", "bond"})
+        if (dem_node->has(single))
+          dem_node->fail(single, "give either dem.materials or dem.density and dem.bond, not both");
+      read_sample(dem_node->child("sample"), model.particles, 1.0);
+      read_materials(*dem_node, model);
+    } else {
+      const double density = dem_node->number("density", Range::positive(), "kg/m^3");
+      read_sample(dem_node->child("sample"), model.particles, density);
+      if (auto bond = dem_node->child_if("bond")) read_bonds(*bond, model);
+    }
     if (auto contact = dem_node->child_if("contact")) {
       double mean_radius = 0.0;
       for (double r : model.particles.radius) mean_radius += r;
