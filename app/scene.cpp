@@ -211,6 +211,13 @@ void read_boundary(CaseNode root, dem::DemModel& model) {
       if (bc.kind == BoundaryKind::displacement) bc.ramp = b.number("ramp", Range::positive(), "s");
       if (bc.kind != BoundaryKind::force) bc.lock_rotation = b.choice_or("rotation", "free", rotations) == "fixed";
     }
+    if (bc.kinematic() && b.has("components")) {
+      bc.components = {false, false, false};
+      for (const std::string& c : b.strings("components")) {
+        if (c != "x" && c != "y" && c != "z") b.fail("components", "expected a list of x, y, z, got '" + c + "'");
+        bc.components[c[0] - 'x'] = true;
+      }
+    }
     b.finish();
     model.add_boundary(bc);
   }

@@ -5,11 +5,13 @@
 //   displacement  linear ramp to value (m) over ramp (s), then held: v = value/ramp, then 0
 //   force         total force value (N) shared equally by the group's DEs (a dead load)
 //   free          nothing imposed; declares that the group must not be constrained
-// Kinematic conditions (fixed, velocity, displacement) lock rotations when rotation: fixed
-// (default for fixed, free otherwise). Force sensors report the quasi-static reaction,
+// Kinematic conditions (fixed, velocity, displacement) act on the listed components (default
+// x, y, z: a roller imposes one), and lock rotations when rotation: fixed (default for fixed,
+// free otherwise). Two kinematic conditions may share a DE if their components differ. Force sensors report the quasi-static reaction,
 // -(sum of bond and contact forces on the group); the external work of a kinematic condition
 // is the work of that reaction plus the change of the driven DEs' kinetic energy.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,6 +28,7 @@ struct BoundaryCondition {
   Vec3 value{};             // m/s, m or N depending on kind
   double ramp = 0.0;        // s, displacement only
   bool lock_rotation = false;
+  std::array<bool, 3> components{true, true, true};  // kinematic: which translations are imposed
 
   bool kinematic() const {
     return kind == BoundaryKind::fixed || kind == BoundaryKind::velocity || kind == BoundaryKind::displacement;

@@ -46,8 +46,9 @@ void DemModel::set_contact(std::unique_ptr<ContactLaw> law, double skin) {
 void DemModel::add_boundary(const BoundaryCondition& bc) { boundaries_.push_back(bc); }
 
 void DemModel::finalize() {
-  // Boundary conditions: each DE gets at most one; a contradiction names both conditions.
-  std::vector<int> owner(particles.size(), -1);
+  // Boundary conditions: each component of a DE's motion has at most one owner (a load or a
+  // free declaration owns all three); a contradiction names both conditions.
+  std::vector<std::array<int, 3>> owner(particles.size(), {-1, -1, -1});
   for (std::size_t c = 0; c < boundaries_.size(); ++c) {
     const BoundaryCondition& bc = boundaries_[c];
     const int g = group_index(bc.group);
@@ -55,14 +56,17 @@ void DemModel::finalize() {
     const auto ids = members(g);
     if (ids.empty()) throw std::invalid_argument("group '" + bc.group + "' has no DE");
     for (std::uint32_t i : ids) {
-      if (owner[i] >= 0) {
-        std::ostringstream msg;
-        msg << "DE " << i << " is in group '" << boundaries_[owner[i]].group << "' (boundary["
-            << owner[i] << "]) and group '" << bc.group << "' (boundary[" << c
-            << "]): one DE can take only one boundary condition";
-        throw std::invalid_argument(msg.str());
+      for (int k = 0; k < 3; ++k) {
+        if (bc.kinematic() && !bc.components[k]) continue;
+        if (owner[i][k] >= 0) {
+          std::ostringstream msg;
+          msg << "DE " << i << " is in group '" << boundaries_[owner[i][k]].group << "' (boundary[" << owner[i][k]
+              << "]) and group '" << bc.group << "' (boundary[" << c << "]), which both set its "
+              << "xyz"[k] << " motion: a component can take only one boundary condition";
+          throw std::invalid_argument(msg.str());
+        }
+        owner[i][k] = static_cast<int>(c);
       }
-      owner[i] = static_cast<int>(c);
       if (bc.kinematic()) constraints_.push_back({i, static_cast<std::uint32_t>(c)});
       if (bc.kind == BoundaryKind::force) {
         loaded_.push_back({i, static_cast<std::uint32_t>(c)});
@@ -72,7 +76,11 @@ void DemModel::finalize() {
   }
   constraint_reaction_.assign(constraints_.size(), Vec3{});
   driven_.assign(particles.size(), 0);
-  for (const Constraint& c : constraints_) driven_[c.particle] = 1;
+  for (const Constraint& c : constraints_) {
+    const BoundaryCondition& bc = boundaries_[c.condition];
+    for (int k = 0; k < 3; ++k) driven_[c.particle] |= bc.components[k] << k;
+    driven_[c.particle] |= bc.lock_rotation << 3;
+  }
   if (damping_ > 0.0) {
     damping_force_.assign(particles.size(), Vec3{});
     damping_torque_.assign(particles.size(), Vec3{});
@@ -169,15 +177,21 @@ void DemModel::kick(double half_dt) {
 void DemModel::impose_motion(double t, bool half_step, double dt) {
   for (const Constraint& c : constraints_) {
     const BoundaryCondition& bc = boundaries_[c.condition];
-    particles.velocity[c.particle] =
-        half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+    const Vec3 v = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+    for (int k = 0; k < 3; ++k)
+      if (bc.components[k]) particles.velocity[c.particle][k] = v[k];
     if (bc.lock_rotation) particles.angular_velocity[c.particle] = {};
   }
 }
 
 double DemModel::driven_kinetic_energy() const {
   double e = 0.0;
-  for (const Constraint& c : constraints_) e += 0.5 * particles.mass(c.particle) * norm2(particles.velocity[c.particle]);
+  for (const Constraint& c : constraints_) {
+    const BoundaryCondition& bc = boundaries_[c.condition];
+    const Vec3& v = particles.velocity[c.particle];
+    for (int k = 0; k < 3; ++k)
+      if (bc.components[k]) e += 0.5 * particles.mass(c.particle) * v[k] * v[k];
+  }
   return e;
 }
 
@@ -284,9 +298,13 @@ void DemModel::record_reactions() {
   }
   // Reaction R = -(bond + contact forces) on each driven DE; over the drift it did the
   // trapezoidal work (R(n) + R(n+1))/2 . dt v(n+1/2).
+  // Only the imposed components: forces along free ones move the DE like any other.
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     const std::uint32_t i = constraints_[k].particle;
-    const Vec3 reaction = -p.force[i];
+    const BoundaryCondition& bc = boundaries_[constraints_[k].condition];
+    Vec3 reaction{};
+    for (int d = 0; d < 3; ++d)
+      if (bc.components[d]) reaction[d] = -p.force[i][d];
     external_work_ += dot(0.5 * (reaction + constraint_reaction_[k]), p.velocity[i]) * last_dt_;
     constraint_reaction_[k] = reaction;
   }
@@ -300,10 +318,12 @@ void DemModel::apply_loads_and_damping() {
     external_work_ += dot(load_per_particle_[k], p.velocity[i]) * last_dt_;
   }
   if (damping_ > 0.0) {
-    // Viscous damping from the half-step velocity, none on driven DEs (their motion is imposed).
+    // Viscous damping from the half-step velocity, none on imposed components.
     for (std::size_t i = 0; i < p.size(); ++i) {
-      damping_force_[i] = driven_[i] ? Vec3{} : p.velocity[i] * (-damping_ * p.mass(i));
-      damping_torque_[i] = driven_[i] ? Vec3{} : p.angular_velocity[i] * (-damping_ * p.inertia(i));
+      damping_force_[i] = p.velocity[i] * (-damping_ * p.mass(i));
+      for (int k = 0; k < 3; ++k)
+        if (driven_[i] & (1 << k)) damping_force_[i][k] = 0.0;
+      damping_torque_[i] = (driven_[i] & 8) ? Vec3{} : p.angular_velocity[i] * (-damping_ * p.inertia(i));
       p.force[i] += damping_force_[i];
       p.torque[i] += damping_torque_[i];
     }

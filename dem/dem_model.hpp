@@ -142,7 +142,7 @@ class DemModel {
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;
   std::vector<Vec3> damping_force_, damping_torque_;  // this step's, kept for both half kicks
-  std::vector<char> driven_;                          // per DE: its motion is imposed
+  std::vector<std::uint8_t> driven_;  // per DE: bits 0-2 imposed x, y, z; bit 3 rotation locked
   double time_ = 0.0;
   double last_dt_ = 0.0;  // s, step size of the step in progress (0 before the first)
   long steps_ = 0;

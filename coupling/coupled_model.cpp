@@ -1,0 +1,240 @@
+#include "coupling/coupled_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace arlequin::coupling {
+
+std::vector<int> group_dofs(const continuum::ContinuumSolver& continuum, const std::string& group,
+                            std::array<bool, 3> components) {
+  std::vector<int> dofs;
+  for (int n : continuum.mesh().group(group).nodes)
+    for (int c = 0; c < 3; ++c)
+      if (components[c]) dofs.push_back(3 * n + c);
+  return dofs;
+}
+
+namespace {
+
+// Weights are evaluated in the reference configuration (DEM positions are swapped to their
+// reference for the call), so a pre-deformed start sees the same weights as an undeformed one.
+bool weight_models(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone) {
+  std::vector<Vec3> current = dem.particles.position;
+  dem.particles.position = dem.particles.reference;
+  dem.apply_arlequin_weight([&zone](const Vec3& x) { return zone.alpha_d(x); }, zone.mass_floor());
+  dem.particles.position.swap(current);
+  continuum.set_weight([zone](const Vec3& x) { return zone.alpha_c(x); });
+  const auto& m = continuum.lumped_mass();
+  if (std::all_of(m.begin(), m.end(), [](double v) { return v > 0.0; })) return false;
+  // A node with alpha_c = 0 at all its mass points (e.g. a natural-neighbour node on the
+  // DEM-side edge of the overlap): ContinuumSolver weights mass and stiffness alike, so the only
+  // floor available is on both (a stiffness of eps times the material there).
+  const double eps = zone.mass_floor();
+  continuum.set_weight([zone, eps](const Vec3& x) { return std::max(zone.alpha_c(x), eps); });
+  for (int n = 0; n < continuum.num_nodes(); ++n)
+    if (!(continuum.lumped_mass()[n] > 0.0)) {
+      const Vec3& x = continuum.nodes()[n];
+      std::ostringstream msg;
+      msg << "coupling: continuum node " << n << " at (" << x.x << ", " << x.y << ", " << x.z
+          << ") has no mass even with the floor";
+      throw InputError(msg.str());
+    }
+  return true;
+}
+
+double frobenius(const Matrix3& m) { return m.size() ? m.norm() : 0.0; }
+
+}  // namespace
+
+CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone,
+                           CoupledOptions options)
+    : dem_(dem), continuum_(continuum), zone_(zone), options_(std::move(options)) {
+  continuum_stiffness_floored_ = weight_models(dem_, continuum_, zone_);
+  dem_.finalize();
+  continuum_.compute_forces();
+  ops_ = CouplingOperators::build(zone_, dem_.particles, continuum_, options_.coupling);
+  const int np = ops_.num_particles(), nn = continuum_.num_nodes();
+
+  inv_mass_d_.resize(np);
+  std::vector<char> driven(dem_.particles.size(), 0);
+  for (std::uint32_t i : options_.driven_des) driven.at(i) = 1;
+  for (int p = 0; p < np; ++p) {
+    const std::uint32_t i = ops_.particles[p];
+    inv_mass_d_[p] = driven[i] ? 0.0 : dem_.particles.inv_mass[i];
+  }
+  inv_mass_c_.resize(3 * static_cast<size_t>(nn));
+  for (int d = 0; d < 3 * nn; ++d) inv_mass_c_[d] = 1.0 / continuum_.lumped_mass()[d / 3];
+  for (int d : options_.held_continuum_dofs) inv_mass_c_.at(d) = 0.0;
+  solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_);
+
+  // Initial velocities onto the constraint.
+  Matrix3 dd, dc;
+  {
+    Matrix3 vd = gather_dem_velocity();
+    solver_->project(vd, continuum_velocity(), dd, dc);
+    scatter_dem_velocity(vd);
+  }
+  // Constraint force at t = 0: the projection of the unconstrained accelerations.
+  Matrix3 ad(np, 3);
+  for (int p = 0; p < np; ++p) {
+    const Vec3& f = dem_.particles.force[ops_.particles[p]];
+    ad.row(p) << f.x * inv_mass_d_[p], f.y * inv_mass_d_[p], f.z * inv_mass_d_[p];
+  }
+  Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
+      Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
+  mu_ = solver_->project(ad, ac, acc_d_, acc_c_);
+  update_monitor(solver_->residual(gather_dem_velocity(), continuum_velocity()));
+  acceleration_norm_ = acceleration_norm();
+
+  time_steps_.dem = dem_.critical_time_step();
+  time_steps_.continuum = continuum_.critical_time_step();
+  time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum);
+}
+
+std::string CoupledModel::summary() const {
+  std::ostringstream s;
+  const auto& w = zone_.weighting();
+  s << "coupling overlap: " << zone_.description() << "\n"
+    << "coupling weights: " << weight_shape_name(w.shape) << ", mass floor " << w.mass_floor;
+  if (continuum_stiffness_floored_) s << " (continuum: on mass and stiffness, some nodes had alpha_c = 0)";
+  s << "\n"
+    << "coupling operators: mediator " << mediator_name(ops_.settings.mediator) << ", "
+    << coupling_type_name(ops_.settings.type);
+  if (ops_.settings.type == CouplingType::h1) s << " (length " << ops_.settings.length << " m)";
+  s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
+    << "coupling matrix A: " << solver_->nonzeros() << " non-zeros, " << solver_->factorizations()
+    << " Cholesky factor(s), reused every step\n"
+    << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum
+    << " s, coupled " << time_steps_.coupled << " s\n";
+  return s.str();
+}
+
+Matrix3 CoupledModel::gather_dem_velocity() const {
+  Matrix3 v(ops_.num_particles(), 3);
+  for (int p = 0; p < ops_.num_particles(); ++p) {
+    const Vec3& u = dem_.particles.velocity[ops_.particles[p]];
+    v.row(p) << u.x, u.y, u.z;
+  }
+  return v;
+}
+
+void CoupledModel::scatter_dem_velocity(const Matrix3& v) {
+  for (int p = 0; p < ops_.num_particles(); ++p) dem_.particles.velocity[ops_.particles[p]] = {v(p, 0), v(p, 1), v(p, 2)};
+}
+
+Eigen::Map<Matrix3> CoupledModel::continuum_velocity() {
+  return Eigen::Map<Matrix3>(continuum_.velocity().data(), continuum_.num_nodes(), 3);
+}
+
+void CoupledModel::step(double dt) {
+  constraint_half_kick(dt);
+  advance_models(dt);
+  kick_to_trial(dt);
+  solve_and_correct(dt);
+  account_energy(dt);
+  time_ += dt;
+  ++steps_;
+}
+
+void CoupledModel::constraint_half_kick(double dt) {
+  const double h = 0.5 * dt;
+  for (int p = 0; p < ops_.num_particles(); ++p)
+    dem_.particles.velocity[ops_.particles[p]] -= Vec3{acc_d_(p, 0), acc_d_(p, 1), acc_d_(p, 2)} * h;
+  continuum_velocity() -= h * acc_c_;
+}
+
+void CoupledModel::advance_models(double dt) {
+  dem_.advance_to_forces(dt);
+  continuum_.kick(0.5 * dt);
+  continuum_.drift(dt);
+  continuum_.compute_forces();
+  drift_residual_ = solver_->residual(gather_dem_velocity(), continuum_velocity());
+}
+
+void CoupledModel::kick_to_trial(double dt) {
+  dem_.finish_step(dt);
+  continuum_.kick(0.5 * dt);
+}
+
+void CoupledModel::solve_and_correct(double dt) {
+  Matrix3 vd = gather_dem_velocity();
+  const Matrix3 lambda = solver_->project(vd, continuum_velocity(), acc_d_, acc_c_);
+  scatter_dem_velocity(vd);
+  const double h = 0.5 * dt;
+  acc_d_ /= h;
+  acc_c_ /= h;
+  const Matrix3 mu = lambda / h;
+  // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2).
+  coupling_work_ -= dt * (0.5 * (mu_ + mu)).cwiseProduct(drift_residual_).sum();
+  mu_ = mu;
+}
+
+void CoupledModel::account_energy(double) {
+  acceleration_norm_ = acceleration_norm();
+  update_monitor(solver_->residual(gather_dem_velocity(), continuum_velocity()));
+  const double scale = frobenius(ops_.Gd * gather_dem_velocity());
+  monitor_.drift_residual = scale > 0 ? frobenius(drift_residual_) / scale : frobenius(drift_residual_);
+}
+
+// sum m |a|^2 with a the constrained accelerations (rotations included).
+std::array<double, 2> CoupledModel::acceleration_norm() const {
+  const auto& P = dem_.particles;
+  std::vector<double> con(P.size() * 3, 0.0);
+  for (int p = 0; p < ops_.num_particles(); ++p)
+    for (int c = 0; c < 3; ++c) con[3 * ops_.particles[p] + c] = acc_d_(p, c);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    const Vec3 a = P.force[i] * P.inv_mass[i] - Vec3{con[3 * i], con[3 * i + 1], con[3 * i + 2]};
+    sum += norm2(a) / P.inv_mass[i] + norm2(P.torque[i]) * P.inv_inertia(i);
+  }
+  double sum_c = 0.0;
+  const auto& f = continuum_.force();
+  for (std::size_t d = 0; d < f.size(); ++d) {
+    if (inv_mass_c_[d] == 0.0) continue;
+    const double a = f[d] * inv_mass_c_[d] - acc_c_(static_cast<Eigen::Index>(d / 3), static_cast<Eigen::Index>(d % 3));
+    sum_c += a * a / inv_mass_c_[d];
+  }
+  return {sum, sum_c};
+}
+
+void CoupledModel::update_monitor(const Matrix3& residual_after) {
+  const Matrix3 vd = gather_dem_velocity();
+  const double scale = frobenius(ops_.Gd * vd);
+  monitor_.constraint_residual = scale > 0 ? frobenius(residual_after) / scale : frobenius(residual_after);
+  const Matrix3 mismatch = vd - ops_.N * Eigen::Map<const Matrix3>(continuum_.velocity().data(), continuum_.num_nodes(), 3);
+  const Eigen::VectorXd per = mismatch.rowwise().norm();
+  monitor_.velocity_mismatch = per.size() ? std::sqrt(per.squaredNorm() / per.size()) : 0.0;
+  monitor_.max_velocity_mismatch = per.size() ? per.maxCoeff() : 0.0;
+}
+
+CoupledEnergies CoupledModel::energies() const {
+  CoupledEnergies e;
+  e.dem = dem_.energies();
+  e.continuum_kinetic = continuum_.kinetic_energy();
+  e.continuum_strain = continuum_.strain_energy();
+  e.coupling_work = coupling_work_;
+  e.dem_acceleration_norm = acceleration_norm_[0];
+  e.continuum_acceleration_norm = acceleration_norm_[1];
+  return e;
+}
+
+double CoupledModel::displacement_residual() const {
+  Matrix3 ud(ops_.num_particles(), 3);
+  for (int p = 0; p < ops_.num_particles(); ++p) {
+    const std::uint32_t i = ops_.particles[p];
+    const Vec3 u = dem_.particles.position[i] - dem_.particles.reference[i];
+    ud.row(p) << u.x, u.y, u.z;
+  }
+  const Eigen::Map<const Matrix3> uc(continuum_.displacement().data(), continuum_.num_nodes(), 3);
+  const double scale = frobenius(ops_.Gd * ud);
+  const double r = frobenius(solver_->residual(ud, uc));
+  return scale > 0 ? r / scale : r;
+}
+
+Matrix3 CoupledModel::dem_coupling_force() const { return -(ops_.Gd.transpose() * mu_); }
+Matrix3 CoupledModel::continuum_coupling_force() const { return -(ops_.Gc.transpose() * mu_); }
+
+}  // namespace arlequin::coupling

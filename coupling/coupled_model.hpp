@@ -1,0 +1,158 @@
+// CoupledModel: a DEM model and a continuum coupled by the Arlequin method with velocity
+// multipliers, advanced by one explicit velocity-Verlet step (DESIGN.md section 2).
+//
+// Contract
+//  - Construction takes a DemModel that is built (DEs, bonds, boundary conditions) but NOT
+//    finalized, and a ContinuumSolver whose weight is untouched; both are borrowed and must
+//    outlive the CoupledModel. It weights them (DEM: masses by max(alpha_d, eps), bonds by
+//    alpha_d at the midpoint; continuum: mass and stiffness integrands by alpha_c), finalizes
+//    the DEM, builds G_d, G_c, factors A once, and puts the initial state on the constraint:
+//    velocities are projected onto G v = 0. Initial displacements must satisfy G u = 0 (e.g.
+//    both at rest, or both on one affine field); displacement_residual() reports it.
+//  - Weights are evaluated in the reference configuration. If some continuum node has no weighted
+//    mass (alpha_c = 0 at all its mass points, e.g. natural-neighbour nodes on the DEM-side edge
+//    of the overlap), the continuum weight becomes max(alpha_c, eps) for mass AND stiffness, as
+//    ContinuumSolver::set_weight has one weight for both; summary() says so. DEs beyond the
+//    overlap on the continuum side must not exist.
+//  - Dofs with essential conditions that lie in the coupling support must be declared
+//    (held_continuum_dofs, driven_des): they get no correction (zero inverse mass in A).
+//  - step(dt), with the constraint acting on accelerations, split over the two half kicks
+//    (RATTLE-like: Andersen, J. Comput. Phys. 52 (1983); for a linear constraint it is velocity
+//    Verlet on the constrained subspace, so G u = 0 and G v = 0 are kept to round-off and the
+//    multiplier forces do no work):
+//      1. constraint_half_kick: v -= dt/2 M^-1 G^T mu(n)          (both models)
+//      2. advance_models: DEM kick dt/2, drift, forces (weighted); continuum likewise
+//      3. kick_to_trial: both kick dt/2 -> trial velocities v*
+//      4. solve_multipliers: A lambda = G_d v_d* + G_c v_c*
+//      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt
+//      6. account_energy: coupling work, velocity mismatch
+//    Steps 3-5 are DESIGN.md section 2 steps 3-5; step 1 is the same constraint force applied
+//    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
+//  - critical_time_step() = min(DEM, continuum): the constrained system's highest frequency
+//    is at most the larger of the two (Rayleigh quotient over a subspace).
+//  - energies(): DEM kinetic + bond + contact and continuum kinetic + strain (both weighted),
+//    DEM external work and dissipation, the work of the multiplier forces, and the O(dt^2)
+//    difference to velocity Verlet's invariant (shadow_total(), conserved to round-off for linear
+//    bonds and no loads; total() oscillates by O((omega dt)^2) around it). Balance:
+//    total - total(0) = dem external work - dissipated + coupling work (continuum external
+//    work of tractions or moving held dofs is not counted).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "continuum/continuum_solver.hpp"
+#include "coupling/coupling_operators.hpp"
+#include "coupling/multiplier_solver.hpp"
+#include "coupling/overlap_zone.hpp"
+#include "dem/dem_model.hpp"
+
+namespace arlequin::coupling {
+
+struct CoupledOptions {
+  CouplingSettings coupling;
+  std::vector<int> held_continuum_dofs;     // 3 * node + component
+  std::vector<std::uint32_t> driven_des;    // DEs with kinematic boundary conditions
+};
+
+// The dofs of a continuum physical group (for held_continuum_dofs).
+std::vector<int> group_dofs(const continuum::ContinuumSolver& continuum, const std::string& group,
+                            std::array<bool, 3> components);
+
+struct TimeSteps {
+  double dem = 0.0;        // s, DEM critical step (weighted masses and bonds)
+  double continuum = 0.0;  // s, continuum critical step (weighted)
+  double coupled = 0.0;    // s, min of both
+};
+
+struct CoupledEnergies {
+  dem::Energies dem;
+  double continuum_kinetic = 0.0;  // J
+  double continuum_strain = 0.0;   // J
+  double coupling_work = 0.0;      // J, work of the multiplier forces on both models
+  // a.M a over each model, a = constrained accelerations at this time (rotations included), J/s^2.
+  double dem_acceleration_norm = 0.0;
+  double continuum_acceleration_norm = 0.0;
+  double total() const { return dem.total() + continuum_kinetic + continuum_strain; }
+  // Velocity Verlet's own invariant, which differs from total() by O((omega dt)^2): for a linear
+  // system it conserves exactly total() - dt^2/8 a.M a (one oscillator:
+  // 1/2 v^2 + 1/2 w^2 u^2 (1 - (w dt)^2 / 4)). J.
+  double shadow_total(double dt) const { return dem_shadow(dt) + continuum_shadow(dt); }
+  double dem_shadow(double dt) const { return dem.total() - dt * dt / 8.0 * dem_acceleration_norm; }
+  double continuum_shadow(double dt) const {
+    return continuum_kinetic + continuum_strain - dt * dt / 8.0 * continuum_acceleration_norm;
+  }
+};
+
+struct CouplingMonitor {
+  double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d| after the last correction
+  double drift_residual = 0.0;         // the same for the drift velocities v(n+1/2)
+  double velocity_mismatch = 0.0;      // rms over coupled DEs of |v_p - (N v_c)(x_p)|, m/s
+  double max_velocity_mismatch = 0.0;  // max of the same, m/s
+};
+
+class CoupledModel {
+ public:
+  CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone,
+               CoupledOptions options = {});
+  CoupledModel(const CoupledModel&) = delete;
+  CoupledModel& operator=(const CoupledModel&) = delete;
+
+  const TimeSteps& time_steps() const { return time_steps_; }
+  double critical_time_step() const { return time_steps_.coupled; }
+  // One line per item: overlap, weights, mediator, counts, A, time steps (printed at start).
+  std::string summary() const;
+
+  void step(double dt);
+  double time() const { return time_; }
+  long steps_done() const { return steps_; }
+
+  CoupledEnergies energies() const;
+  const CouplingMonitor& monitor() const { return monitor_; }
+  // |G_d u_d + G_c u_c| / |G_d u_d| for the current displacements.
+  double displacement_residual() const;
+
+  const OverlapZone& zone() const { return zone_; }
+  const CouplingOperators& operators() const { return ops_; }
+  const MultiplierSolver& multipliers() const { return *solver_; }
+  dem::DemModel& dem() { return dem_; }
+  continuum::ContinuumSolver& continuum() { return continuum_; }
+  // Multiplier forces of the last step on the coupled DEs / continuum nodes, N (-G^T mu).
+  Matrix3 dem_coupling_force() const;
+  Matrix3 continuum_coupling_force() const;
+
+ private:
+  // The phases of step(), in order (see the contract above).
+  void constraint_half_kick(double dt);
+  void advance_models(double dt);
+  void kick_to_trial(double dt);
+  void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
+  void account_energy(double dt);
+
+  Matrix3 gather_dem_velocity() const;
+  void scatter_dem_velocity(const Matrix3& v);
+  Eigen::Map<Matrix3> continuum_velocity();
+  void update_monitor(const Matrix3& residual_after);
+
+  dem::DemModel& dem_;
+  continuum::ContinuumSolver& continuum_;
+  OverlapZone zone_;
+  CoupledOptions options_;
+  CouplingOperators ops_;
+  std::unique_ptr<MultiplierSolver> solver_;
+  std::vector<double> inv_mass_d_, inv_mass_c_;
+  Matrix3 acc_d_, acc_c_;  // constraint accelerations M^-1 G^T mu(n) (subtracted)
+  Matrix3 mu_;             // multipliers of the constraint force at t(n)
+  Matrix3 drift_residual_;
+  TimeSteps time_steps_;
+  CouplingMonitor monitor_;
+  bool continuum_stiffness_floored_ = false;
+  double coupling_work_ = 0.0;
+  std::array<double, 2> acceleration_norm_{};  // DEM, continuum
+  std::array<double, 2> acceleration_norm() const;
+  double time_ = 0.0;
+  long steps_ = 0;
+};
+
+}  // namespace arlequin::coupling

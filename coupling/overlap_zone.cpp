@@ -1,0 +1,122 @@
+#include "coupling/overlap_zone.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace arlequin::coupling {
+
+namespace {
+
+constexpr double kRampTolerance = 1e-9;  // s within [-tol, 1 + tol] counts as in the overlap
+
+void check_weighting(const OverlapZone::Weighting& w) {
+  if (!(w.mass_floor > 0.0 && w.mass_floor <= 1.0))
+    throw InputError("coupling: mass floor eps must lie in (0, 1], got " + std::to_string(w.mass_floor));
+  if (w.shape == WeightShape::constant && !(w.constant_value > 0.0 && w.constant_value < 1.0))
+    throw InputError("coupling: the constant weight must lie in (0, 1), got " + std::to_string(w.constant_value));
+}
+
+std::string vec(const Vec3& v) {
+  std::ostringstream s;
+  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return s.str();
+}
+
+}  // namespace
+
+WeightShape weight_shape_from_name(const std::string& name) {
+  if (name == "constant") return WeightShape::constant;
+  if (name == "linear") return WeightShape::linear;
+  if (name == "cubic") return WeightShape::cubic;
+  throw InputError("unknown weight shape '" + name + "' (known: constant, linear, cubic)");
+}
+
+const char* weight_shape_name(WeightShape shape) {
+  switch (shape) {
+    case WeightShape::constant: return "constant";
+    case WeightShape::linear: return "linear";
+    case WeightShape::cubic: return "cubic";
+  }
+  return "?";
+}
+
+OverlapZone::OverlapZone(Membership contains, RampCoordinate ramp, Weighting weighting, std::string description)
+    : contains_(std::move(contains)), ramp_(std::move(ramp)), weighting_(weighting), description_(std::move(description)) {
+  check_weighting(weighting_);
+}
+
+OverlapZone::OverlapZone(const Region& region, RampCoordinate ramp, Weighting weighting)
+    : OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting,
+                  region.describe()) {}
+
+double OverlapZone::alpha_d(const Vec3& x) const {
+  const double s = ramp_(x);
+  if (s < -kRampTolerance) return 1.0;
+  if (s > 1.0 + kRampTolerance) return 0.0;
+  const double t = std::clamp(s, 0.0, 1.0);
+  switch (weighting_.shape) {
+    case WeightShape::constant: return weighting_.constant_value;
+    case WeightShape::linear: return 1.0 - t;
+    case WeightShape::cubic: return 1.0 - t * t * (3.0 - 2.0 * t);
+  }
+  return 1.0;
+}
+
+OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Weighting weighting) {
+  if (axis < 0 || axis > 2) throw InputError("coupling: overlap box axis must be 0, 1 or 2");
+  const double lo = b.lower[axis], hi = b.upper[axis];
+  if (!(hi > lo)) throw InputError("coupling: overlap box has no extent along its ramp axis");
+  RampCoordinate ramp = dem_on_lower_side ? RampCoordinate([=](const Vec3& x) { return (x[axis] - lo) / (hi - lo); })
+                                          : RampCoordinate([=](const Vec3& x) { return (hi - x[axis]) / (hi - lo); });
+  const Region region{b};
+  std::ostringstream d;
+  d << "box " << vec(b.lower) << "-" << vec(b.upper) << ", ramp along axis " << axis << " with the DEM on the "
+    << (dem_on_lower_side ? "lower" : "upper") << " side";
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting, d.str());
+}
+
+OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting weighting) {
+  if (!(c.length > 0.0)) throw InputError("coupling: an overlap cylinder needs a positive length");
+  const Vec3 base = c.base, axis = c.axis;
+  const double length = c.length;
+  RampCoordinate ramp = [=](const Vec3& x) {
+    const double s = dot(x - base, axis) / length;
+    return dem_at_base ? s : 1.0 - s;
+  };
+  const Region region{c};
+  std::ostringstream d;
+  d << "cylinder base " << vec(base) << " axis " << vec(axis) << " radius " << c.radius << " length " << length
+    << ", ramp along the axis with the DEM at the " << (dem_at_base ? "base" : "top");
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting, d.str());
+}
+
+OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting weighting) {
+  bool ramps = false;
+  for (int k = 0; k < 3; ++k) {
+    if (!(outer.lower[k] <= inner.lower[k] && inner.lower[k] < inner.upper[k] && inner.upper[k] <= outer.upper[k]))
+      throw InputError("coupling: overlap shell needs the inner box strictly inside the outer one");
+    ramps = ramps || outer.lower[k] < inner.lower[k] || inner.upper[k] < outer.upper[k];
+  }
+  if (!ramps) throw InputError("coupling: overlap shell has the same inner and outer box");
+  RampCoordinate ramp = [=](const Vec3& x) {
+    double s = -1e300;
+    for (int k = 0; k < 3; ++k) {
+      if (outer.lower[k] < inner.lower[k])
+        s = std::max(s, (inner.lower[k] - x[k]) / (inner.lower[k] - outer.lower[k]));
+      if (inner.upper[k] < outer.upper[k])
+        s = std::max(s, (x[k] - inner.upper[k]) / (outer.upper[k] - inner.upper[k]));
+    }
+    return s;
+  };
+  const Region out{outer};
+  Membership contains = [out, ramp](const Vec3& x) { return out.contains(x) && ramp(x) >= -kRampTolerance; };
+  std::ostringstream d;
+  d << "shell between box " << vec(inner.lower) << "-" << vec(inner.upper) << " (DEM inside) and box "
+    << vec(outer.lower) << "-" << vec(outer.upper);
+  return OverlapZone(std::move(contains), std::move(ramp), weighting, d.str());
+}
+
+}  // namespace arlequin::coupling

@@ -1,0 +1,76 @@
+// OverlapZone: where the DEM and the continuum coexist, and the Arlequin weights there.
+//
+// Contract
+//  - A ramp coordinate s(x) runs across the overlap: s = 0 on its DEM-side boundary, s = 1 on
+//    its continuum-side boundary, s < 0 in the pure-DEM zone, s > 1 in the pure-continuum zone.
+//  - Weights (Ben Dhia & Rateau, IJNME 62 (2005) section 2; Xiao & Belytschko, CMAME 193 (2004)
+//    Eq. 8): alpha_d(x) + alpha_c(x) = 1 everywhere, alpha_d = 1 in the pure-DEM zone and 0 in
+//    the pure-continuum zone; across the overlap (s in [0, 1], boundaries included):
+//      constant  alpha_d = c (default 1/2), a jump at both boundaries
+//      linear    alpha_d = 1 - s
+//      cubic     alpha_d = 1 - (3 s^2 - 2 s^3)   (C1 at both boundaries)
+//  - mass_floor eps: DE masses are weighted by max(alpha_d, eps) (DemModel::apply_arlequin_weight),
+//    so no DE has a zero mass at the continuum-side edge. Stiffness is never floored.
+//  - contains(x): x in the overlap (its boundaries included, relative tolerance 1e-9), which is
+//    where DEs are coupled. DEs beyond the overlap on the continuum side (alpha_d = 0) must not
+//    exist: their bonds would carry no stiffness and nothing would hold them.
+//  - Shapes: a box slab (ramp along one axis), a finite cylinder (ramp along its axis), the shell
+//    between two nested boxes (DEM inside the inner box, continuum outside the outer one), or
+//    any common Region with a caller-given ramp coordinate (sphere, half-space, ...).
+//  - Bad input (empty slab, non-nested shell, unknown shape name) is an InputError.
+#pragma once
+#include <functional>
+#include <string>
+
+#include "common/region.hpp"
+#include "common/vec3.hpp"
+
+namespace arlequin::coupling {
+
+enum class WeightShape { constant, linear, cubic };
+// "constant", "linear" or "cubic"; InputError otherwise (the message lists the names).
+WeightShape weight_shape_from_name(const std::string& name);
+const char* weight_shape_name(WeightShape shape);
+
+class OverlapZone {
+ public:
+  using RampCoordinate = std::function<double(const Vec3&)>;
+  using Membership = std::function<bool(const Vec3&)>;
+
+  struct Weighting {
+    WeightShape shape = WeightShape::linear;
+    double mass_floor = 0.05;     // eps in (0, 1]
+    double constant_value = 0.5;  // alpha_d inside the overlap for the constant shape, in (0, 1)
+  };
+
+  // Generic: membership from a common Region, ramp coordinate from the caller.
+  OverlapZone(const Region& region, RampCoordinate ramp, Weighting weighting);
+
+  // Box slab; the ramp runs along `axis` (0, 1, 2). dem_on_lower_side: the DEM lies at
+  // x[axis] < box.lower[axis] (s = 0 on the lower face), else on the upper side.
+  static OverlapZone box(const Box& box, int axis, bool dem_on_lower_side, Weighting weighting);
+  // Finite cylinder (length > 0); the ramp runs along the axis, DEM beyond the base
+  // (dem_at_base) or beyond the top.
+  static OverlapZone cylinder(const Cylinder& cylinder, bool dem_at_base, Weighting weighting);
+  // Shell outer \ inner between nested boxes: DEM inside `inner`, continuum outside `outer`.
+  // s = max over axes and sides of the fractional distance from the inner face to the outer
+  // face; a side where the two faces coincide does not ramp.
+  static OverlapZone shell(const Box& inner, const Box& outer, Weighting weighting);
+
+  bool contains(const Vec3& x) const { return contains_(x); }
+  double ramp(const Vec3& x) const { return ramp_(x); }
+  double alpha_d(const Vec3& x) const;
+  double alpha_c(const Vec3& x) const { return 1.0 - alpha_d(x); }
+  double mass_floor() const { return weighting_.mass_floor; }
+  const Weighting& weighting() const { return weighting_; }
+  const std::string& description() const { return description_; }
+
+ private:
+  OverlapZone(Membership contains, RampCoordinate ramp, Weighting weighting, std::string description);
+  Membership contains_;
+  RampCoordinate ramp_;
+  Weighting weighting_;
+  std::string description_;
+};
+
+}  // namespace arlequin::coupling

@@ -1,0 +1,52 @@
+// Overlap zone and weight functions: alpha_d + alpha_c = 1, shapes across the ramp, membership.
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "coupling/overlap_zone.hpp"
+
+using namespace arlequin;
+using namespace arlequin::coupling;
+
+TEST(CouplingOverlapZone, BoxSlabWeights) {
+  const Box b{{2, 0, 0}, {6, 1, 1}};
+  const OverlapZone lin = OverlapZone::box(b, 0, true, {WeightShape::linear, 0.05, 0.5});
+  EXPECT_DOUBLE_EQ(lin.alpha_d({1, 0.5, 0.5}), 1.0);
+  EXPECT_DOUBLE_EQ(lin.alpha_d({2, 0.5, 0.5}), 1.0);
+  EXPECT_DOUBLE_EQ(lin.alpha_d({3, 0.5, 0.5}), 0.75);
+  EXPECT_DOUBLE_EQ(lin.alpha_d({6, 0.5, 0.5}), 0.0);
+  EXPECT_DOUBLE_EQ(lin.alpha_d({7, 0.5, 0.5}), 0.0);
+  EXPECT_DOUBLE_EQ(lin.alpha_d({3, 0.5, 0.5}) + lin.alpha_c({3, 0.5, 0.5}), 1.0);
+  EXPECT_TRUE(lin.contains({2, 0, 0}));
+  EXPECT_TRUE(lin.contains({6, 1, 1}));
+  EXPECT_FALSE(lin.contains({6.01, 0.5, 0.5}));
+  const OverlapZone cub = OverlapZone::box(b, 0, true, {WeightShape::cubic, 0.05, 0.5});
+  EXPECT_DOUBLE_EQ(cub.alpha_d({4, 0.5, 0.5}), 0.5);
+  EXPECT_NEAR(cub.alpha_d({3, 0.5, 0.5}), 1.0 - (3 * 0.0625 - 2 * 0.015625), 1e-15);
+  const OverlapZone con = OverlapZone::box(b, 0, false, {WeightShape::constant, 0.05, 0.3});
+  EXPECT_DOUBLE_EQ(con.alpha_d({1, 0.5, 0.5}), 0.0);  // DEM on the upper side now
+  EXPECT_DOUBLE_EQ(con.alpha_d({2, 0.5, 0.5}), 0.3);
+  EXPECT_DOUBLE_EQ(con.alpha_d({6, 0.5, 0.5}), 0.3);
+  EXPECT_DOUBLE_EQ(con.alpha_d({6.5, 0.5, 0.5}), 1.0);
+}
+
+TEST(CouplingOverlapZone, ShellAndCylinder) {
+  const OverlapZone shell = OverlapZone::shell({{-1, -1, -1}, {1, 1, 1}}, {{-3, -2, -1}, {3, 2, 1}}, {});
+  EXPECT_DOUBLE_EQ(shell.alpha_d({0, 0, 0}), 1.0);
+  EXPECT_FALSE(shell.contains({0, 0, 0}));
+  EXPECT_DOUBLE_EQ(shell.alpha_d({2, 0, 0}), 0.5);   // half way from x = 1 to x = 3
+  EXPECT_DOUBLE_EQ(shell.alpha_d({0, 1.5, 0}), 0.5);  // half way from y = 1 to y = 2
+  EXPECT_TRUE(shell.contains({2, 0, 0.5}));
+  EXPECT_DOUBLE_EQ(shell.alpha_d({3, 2, 0}), 0.0);
+  const OverlapZone cyl = OverlapZone::cylinder({{0, 0, 0}, {0, 0, 1}, 1.0, 4.0}, true, {});
+  EXPECT_DOUBLE_EQ(cyl.alpha_d({0, 0, 1}), 0.75);
+  EXPECT_TRUE(cyl.contains({0.5, 0, 1}));
+  EXPECT_FALSE(cyl.contains({1.5, 0, 1}));
+}
+
+TEST(CouplingOverlapZone, BadInputIsAnInputError) {
+  EXPECT_THROW(OverlapZone::box({{0, 0, 0}, {0, 1, 1}}, 0, true, {}), InputError);
+  EXPECT_THROW(OverlapZone::box({{0, 0, 0}, {1, 1, 1}}, 0, true, {WeightShape::linear, 0.0, 0.5}), InputError);
+  EXPECT_THROW(OverlapZone::shell({{0, 0, 0}, {2, 2, 2}}, {{1, 1, 1}, {3, 3, 3}}, {}), InputError);
+  EXPECT_THROW(weight_shape_from_name("quadratic"), InputError);
+  EXPECT_EQ(weight_shape_from_name("cubic"), WeightShape::cubic);
+}
