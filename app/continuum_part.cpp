@@ -10,6 +10,8 @@
 #include "common/json.hpp"
 #include "continuum/continuum_solver.hpp"
 #include "continuum/registry.hpp"
+#include "coupling/coupled_model.hpp"
+#include "common/region.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -67,8 +69,35 @@ class Part final : public ContinuumPart {
 
   ContinuumSolver& solver() override { return *solver_; }
   bool is_static() const override { return static_; }
-  double critical_time_step() const override { return static_ ? INFINITY : solver_->critical_time_step(); }
-  void step(double dt) override { solver_->step(dt); }
+  double critical_time_step() const override {
+    if (coupled_) return coupled_->critical_time_step();
+    return static_ ? INFINITY : solver_->critical_time_step();
+  }
+  void step(double dt) override { coupled_ ? coupled_->step(dt) : solver_->step(dt); }
+  bool is_coupled() const override { return coupled_ != nullptr; }
+  std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
+  double coupling_work() const override { return coupled_ ? coupled_->energies().coupling_work : 0.0; }
+
+  void couple(CaseNode section, dem::DemModel& dem) override {
+    if (static_) section.fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
+    coupling::OverlapZone::Weighting weighting;
+    static constexpr std::string_view shapes[] = {"linear", "cubic", "constant"};
+    weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
+    weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
+    weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
+    const coupling::OverlapZone zone = read_overlap(section.child("overlap"), weighting);
+    coupling::CoupledOptions options;
+    static constexpr std::string_view mediators[] = {"coarse", "fine"};
+    static constexpr std::string_view types[] = {"l2", "h1"};
+    options.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
+    options.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
+    if (options.coupling.type == coupling::CouplingType::h1)
+      options.coupling.length = section.number("length", Range::positive(), "m");
+    section.finish();
+    options.held_continuum_dofs = held_dofs_;
+    options.driven_des = dem.driven_particles();
+    coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, zone, options);
+  }
   void solve_static() override { solver_->solve_static(petsc_options_); }
   bool has_group(const std::string& name) const override { return solver_->mesh().has_group(name); }
 
@@ -117,6 +146,7 @@ class Part final : public ContinuumPart {
     counts["continuum_nodes"] = solver_->num_nodes();
     counts["continuum_tetrahedra"] = solver_->mesh().num_tets();
     counts["continuum_order"] = solver_->mesh().order();
+    if (coupled_) counts["coupled_particles"] = coupled_->operators().num_particles();
   }
 
  private:
@@ -131,6 +161,34 @@ class Part final : public ContinuumPart {
     std::vector<Vec3> out(f.size() / 3);
     for (std::size_t n = 0; n < out.size(); ++n) out[n] = node_vector(f, int(n));
     return out;
+  }
+
+  static coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone::Weighting& weighting) {
+    static constexpr std::string_view axes[] = {"x", "y", "z"};
+    static constexpr std::string_view box_sides[] = {"lower", "upper"};
+    static constexpr std::string_view cylinder_sides[] = {"base", "top"};
+    if (overlap.has("shell")) {
+      CaseNode shell = overlap.child("shell");
+      const auto inner = shell.vec3_list("inner", Range::any(), "m"), outer = shell.vec3_list("outer", Range::any(), "m");
+      if (inner.size() != 2 || outer.size() != 2) shell.fail("inner", "expected two boxes [[x0,y0,z0],[x1,y1,z1]]");
+      shell.finish();
+      overlap.finish();
+      return coupling::OverlapZone::shell(Box{inner[0], inner[1]}, Box{outer[0], outer[1]}, weighting);
+    }
+    const Region region = Region::read(overlap);
+    if (const auto* box = std::get_if<Box>(&region.shape())) {
+      const int axis = overlap.choice("axis", axes)[0] - 'x';
+      const bool lower = overlap.choice("dem_side", box_sides) == "lower";
+      overlap.finish();
+      return coupling::OverlapZone::box(*box, axis, lower, weighting);
+    }
+    if (const auto* cylinder = std::get_if<Cylinder>(&region.shape())) {
+      if (cylinder->length < 0.0) overlap.fail("cylinder", "an overlap cylinder needs a length");
+      const bool base = overlap.choice("dem_side", cylinder_sides) == "base";
+      overlap.finish();
+      return coupling::OverlapZone::cylinder(*cylinder, base, weighting);
+    }
+    overlap.fail("box", "an overlap is a box, a cylinder or a shell");
   }
 
   void read_boundary(CaseNode bc) {
@@ -172,9 +230,13 @@ class Part final : public ContinuumPart {
     }
     bc.finish();
     solver_->fix(group, components, g);
+    const auto dofs = coupling::group_dofs(*solver_, group, components);
+    held_dofs_.insert(held_dofs_.end(), dofs.begin(), dofs.end());
   }
 
   std::unique_ptr<ContinuumSolver> solver_;
+  std::unique_ptr<coupling::CoupledModel> coupled_;
+  std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)
   std::string petsc_options_;
   bool static_ = false;
 };

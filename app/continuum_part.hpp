@@ -18,6 +18,15 @@
 //       - {group, type: velocity, value [m/s], rise [s], duration [s]}  velocity ramped up over
 //         `rise` (linear), imposed until `duration`, then the displacement is held
 //       - {group, type: traction, value [Pa]}               on a surface group
+//
+// Coupled to the DEM by the Arlequin method (coupling/) when the case has a `coupling:` section:
+//   coupling:
+//     overlap: {box: [[..], [..]], axis: x | y | z, dem_side: lower | upper}
+//            | {cylinder: {base, axis, radius, length}, dem_side: base | top}
+//            | {shell: {inner: [[..], [..]], outer: [[..], [..]]}}       (DEM inside `inner`)
+//     weight: linear | cubic | constant   (constant_value: 0.5), mass_floor: 0.05
+//     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
+// Then step() advances both models together and the DEM is finalized by the coupling.
 #pragma once
 #include <filesystem>
 #include <memory>
@@ -27,6 +36,9 @@
 
 namespace arlequin {
 class CaseNode;
+namespace dem {
+class DemModel;
+}
 class FieldsWriter;
 class Json;
 namespace continuum {
@@ -43,9 +55,15 @@ class ContinuumPart {
   virtual ~ContinuumPart() = default;
 
   virtual continuum::ContinuumSolver& solver() = 0;
+  // Couples `dem` (built, with its boundary conditions, not finalized) to this continuum; the
+  // coupling finalizes it. std::invalid_argument for contradictory DEM boundary conditions.
+  virtual void couple(CaseNode section, dem::DemModel& dem) = 0;
+  virtual bool is_coupled() const = 0;
+  virtual std::string coupling_summary() const = 0;  // one line per item, printed at start
+  virtual double coupling_work() const = 0;          // J, work of the multiplier forces
   virtual bool is_static() const = 0;
-  virtual double critical_time_step() const = 0;
-  virtual void step(double dt) = 0;    // one explicit step
+  virtual double critical_time_step() const = 0;  // of the coupled system when coupled
+  virtual void step(double dt) = 0;    // one explicit step (of both models when coupled)
   virtual void solve_static() = 0;     // equilibrium at the current time
   virtual bool has_group(const std::string& name) const = 0;
   virtual Vec3 mean_displacement(const std::string& group) const = 0;  // over the group's nodes, m

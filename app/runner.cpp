@@ -27,6 +27,17 @@ constexpr const char* energy_columns[] = {"E_kinetic",    "E_bond",     "E_conta
                                           "E_dissipated", "E_fracture", "E_total",   "E_balance"};
 
 // Writes the output files of one run; every file is replaced atomically.
+double coupling_work(const Scene& scene) {
+  return scene.continuum && scene.continuum->is_coupled() ? scene.continuum->coupling_work() : 0.0;
+}
+
+// Stored energy of the whole scene: DEM kinetic + bond + contact, continuum kinetic + strain.
+double scene_total(const Scene& scene, const dem::Energies& e) {
+  double total = e.total();
+  if (scene.continuum) total += scene.continuum->kinetic_energy() + scene.continuum->strain_energy();
+  return total;
+}
+
 class Outputs {
  public:
   Outputs(const Scene& scene) : scene_(scene) {
@@ -35,6 +46,7 @@ class Outputs {
     for (auto& c : sensor_columns(scene)) columns.push_back(c);
     for (const char* c : energy_columns) columns.push_back(c);
     if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
+    if (scene.continuum && scene.continuum->is_coupled()) columns.push_back("W_coupling");
     if (scene.dem.failure_enabled())
       for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
     series_.emplace(scene.output.dir / "series.csv", columns);
@@ -58,12 +70,15 @@ class Outputs {
           values.emplace_back(names[column++], v[k]);
         }
     }
-    for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture, e.total(),
-                     e.balance(initial_total)})
+    // With a continuum, E_total and E_balance cover both models (and the coupling's work).
+    const double total = scene_total(scene_, e);
+    const double balance = total + e.dissipated + e.fracture - e.external_work - coupling_work(scene_) - initial_total;
+    for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture, total, balance})
       row_.push_back(x);
     if (scene_.continuum) {
       row_.push_back(scene_.continuum->kinetic_energy());
       row_.push_back(scene_.continuum->strain_energy());
+      if (scene_.continuum->is_coupled()) row_.push_back(scene_.continuum->coupling_work());
     }
     if (scene_.dem.failure_enabled()) {
       for (const auto& set : scene_.dem.bond_sets()) {
@@ -247,7 +262,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Outputs outputs(scene);
   Progress progress(options.show_progress, total_steps);
   RunResult result;
-  const double initial_total = model.energies().total();
+  const double initial_total = scene_total(scene, model.energies());
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
   // the motion that boundary conditions impose.
@@ -280,8 +295,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     }
     write_outputs();
     for (long n = 1; n <= total_steps; ++n) {
-      if (model.particles.size() > 0) model.step(scene.dt);
-      if (scene.continuum) scene.continuum->step(scene.dt);
+      const bool coupled = scene.continuum && scene.continuum->is_coupled();
+      if (model.particles.size() > 0 && !coupled) model.step(scene.dt);
+      if (scene.continuum) scene.continuum->step(scene.dt);  // both models when coupled
       ++steps_done;
       if (n == 1) energy_scale = std::max(energy_scale, model.energies().kinetic);
       model.check_finite();

@@ -221,11 +221,22 @@ void read_boundary(CaseNode root, dem::DemModel& model) {
     b.finish();
     model.add_boundary(bc);
   }
+}
+
+// Finalizes the DEM, through the coupling when the case couples it to the continuum; a
+// contradiction between boundary conditions is reported at the boundary section.
+void finalize_dem(CaseNode root, Scene& scene) {
+  std::optional<CaseNode> coupling = root.child_if("coupling");
+  if (coupling && (!scene.continuum || scene.dem.particles.size() == 0))
+    coupling->fail("overlap", "coupling needs both a dem and a continuum section");
   try {
-    model.finalize();
+    if (coupling)
+      scene.continuum->couple(*coupling, scene.dem);
+    else
+      scene.dem.finalize();
   } catch (const std::invalid_argument& e) {
-    if (entries.empty()) throw InputError(root.where() + ": " + e.what());
-    root.fail("boundary", e.what());
+    if (root.has("boundary")) root.fail("boundary", e.what());
+    throw InputError(root.where() + ": " + e.what());
   }
 }
 
@@ -381,6 +392,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   }
   read_sensors(root, scene);
   if (dem_node) read_boundary(root, model);
+  finalize_dem(root, scene);
 
   std::optional<CaseNode> time = static_only ? root.child_if("time") : root.child("time");
   scene.end_time = time ? time->number("end", Range::positive(), "s") : 1.0;
@@ -388,8 +400,11 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   scene.safety = time ? time->number_or("safety", 0.3, Range::open_between(0.0, 1.0), "1") : 0.3;
   if (time) time->finish();
 
+  // Coupled: the coupled system's step (the smaller of both, weighted); else each model's.
   scene.dt_critical = model.critical_time_step();
-  if (scene.continuum) scene.dt_critical = std::min(scene.dt_critical, scene.continuum->critical_time_step());
+  if (scene.continuum)
+    scene.dt_critical = scene.continuum->is_coupled() ? scene.continuum->critical_time_step()
+                                                       : std::min(scene.dt_critical, scene.continuum->critical_time_step());
   if (static_only) {
     scene.dt = scene.end_time;  // one static solve
   } else if (user_dt) {

@@ -45,6 +45,18 @@ void DemModel::set_contact(std::unique_ptr<ContactLaw> law, double skin) {
 
 void DemModel::add_boundary(const BoundaryCondition& bc) { boundaries_.push_back(bc); }
 
+std::vector<std::uint32_t> DemModel::driven_particles() const {
+  std::vector<std::uint32_t> out;
+  for (const BoundaryCondition& bc : boundaries_) {
+    const int g = group_index(bc.group);
+    if (!bc.kinematic() || g < 0) continue;
+    for (std::uint32_t i : members(g)) out.push_back(i);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 void DemModel::finalize() {
   // Boundary conditions: each component of a DE's motion has at most one owner (a load or a
   // free declaration owns all three); a contradiction names both conditions.

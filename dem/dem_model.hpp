@@ -50,6 +50,8 @@ class DemModel {
   bool has_contact() const { return contact_ != nullptr; }
   const NeighbourList* neighbours() const { return neighbours_ ? &*neighbours_ : nullptr; }
   void add_boundary(const BoundaryCondition& bc);
+  // DEs whose motion a kinematic condition imposes (valid before finalize()).
+  std::vector<std::uint32_t> driven_particles() const;
   // Viscous damping, force -c m v and torque -c I omega, c in 1/s (quasi-static runs).
   void set_damping(double coefficient) { damping_ = coefficient; }
   // Reaction forces of this group are recorded every step (for force sensors).
