@@ -28,6 +28,7 @@ constexpr const char* usage_main =
     "  run CASE.yaml     run a case, write results (series.csv, fields.h5/.xdmf, summary.json)\n"
     "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
     "  sweep CASE.yaml   run a case over several values of its keys; table of errors and run times\n"
+    "  build-sample CASE.yaml   build the case's packing (dem.sample.build: packing) and save it\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -64,7 +65,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check", "sweep"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -72,7 +73,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -113,6 +114,13 @@ Arguments parse(int argc, char** argv) {
 void print_scene_facts(const app::Scene& scene) {
   const auto& model = scene.dem;
   std::printf("case: %s\n  DEs: %zu\n", scene.name.c_str(), model.particles.size());
+  if (scene.sample) {
+    const auto& r = scene.sample->report;
+    std::printf("  packing (%s): compaction %.4f, coordination %.2f (interior %.2f), fabric eigenvalues %.4f %.4f %.4f,"
+                " max overlap %.1e R, built in %.1f s\n",
+                scene.sample_file.string().c_str(), r.compaction, r.mean_coordination, r.interior_coordination,
+                r.fabric_eigenvalues[0], r.fabric_eigenvalues[1], r.fabric_eigenvalues[2], r.max_overlap, r.seconds);
+  }
   for (const auto& set : model.bond_sets())
     std::printf("  %s bonds (%s): %zu\n", set->name.c_str(), std::string(set->law()).c_str(), set->size());
   if (model.particles.size() > 0)
@@ -160,6 +168,18 @@ int sweep(const Arguments& a) {
   return ok ? 0 : 5;
 }
 
+int build_sample(const Arguments& a) {
+  app::SceneOptions options = a.scene;
+  options.rebuild_sample = true;
+  app::Scene scene = app::build_scene(a.case_file, options);
+  if (!scene.sample) throw InputError(a.case_file + ": dem.sample.build is not packing: there is no sample to build");
+  print_scene_facts(scene);
+  std::printf("radius histogram (centre m, DEs):\n");
+  for (const auto& [centre, count] : scene.sample->report.radius_histogram) std::printf("  %.4e %zu\n", centre, count);
+  std::printf("sample: %s\n", std::filesystem::absolute(scene.sample_file).string().c_str());
+  return 0;
+}
+
 int check(const Arguments& a) {
   app::Scene scene = app::build_scene(a.case_file, a.scene);
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
@@ -181,7 +201,10 @@ int main(int argc, char** argv) {
                  stdout);
       return 0;
     }
-    return a.command == "run" ? run(a) : a.command == "sweep" ? sweep(a) : check(a);
+    if (a.command == "run") return run(a);
+    if (a.command == "sweep") return sweep(a);
+    if (a.command == "build-sample") return build_sample(a);
+    return check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());
     return 2;

@@ -10,6 +10,7 @@
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/region.hpp"
+#include "dem/sample_file.hpp"
 #include "dem/samples.hpp"
 
 namespace arlequin::app {
@@ -20,10 +21,52 @@ using dem::BoundaryKind;
 
 constexpr std::string_view component_names[] = {"x", "y", "z", "all"};
 
-void read_sample(CaseNode sample, dem::ParticleSet& p, double density) {
-  static constexpr std::string_view builders[] = {"lattice", "chain", "particles"};
+// A dense random packing (dem/packing.hpp), cached in an HDF5 sample file: built once, then
+// loaded while the file's spec matches the case's.
+void read_packing(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
+  dem::PackingSpec spec{Region(Box{}), 0.0, 0.0};
+  CaseNode region = sample.child("region");
+  spec.region = Region::read(region);
+  region.finish();
+  CaseNode radius = sample.child("radius");
+  spec.mean_radius = radius.number("mean", Range::positive(), "m");
+  spec.relative_std = radius.number_or("std", 0.15, Range::between(0.0, 0.5), "1");
+  spec.truncation = radius.number_or("truncation", 2.0, Range::positive(), "1");
+  radius.finish();
+  spec.target_compaction = sample.number_or("compaction", 0.63, Range::open_between(0.0, 0.7), "1");
+  spec.min_coordination = sample.number_or("min_coordination", 6.0, Range::non_negative(), "1");
+  spec.seed = static_cast<std::uint64_t>(sample.integer_or("seed", 1, Range::at_least(0)));
+  spec.bond_tolerance = sample.number_or("bond_tolerance", 0.03, Range::between(0.0, 0.5), "1");
+  std::filesystem::path file = sample.string_or("file", "results/" + scene.name + "/sample.h5");
+  if (file.is_relative()) file = scene.case_file.parent_path() / file;
+  scene.sample_file = file;
+  dem::ParticleSet& p = scene.dem.particles;
+  if (!options.rebuild_sample && std::filesystem::exists(file)) {
+    dem::ParticleSet loaded;
+    dem::SampleRecord record = dem::load_sample(file, loaded, density);
+    if (record.spec == spec) {
+      p = std::move(loaded);
+      scene.sample = std::move(record);
+      return;
+    }
+  }
+  try {
+    scene.sample = dem::SampleRecord{spec, dem::build_packing(p, spec, density)};
+  } catch (const std::invalid_argument& e) {
+    sample.fail("region", e.what());
+  } catch (const RunError& e) {
+    sample.fail("compaction", e.what());
+  }
+  dem::save_sample(file, p, spec, scene.sample->report);
+}
+
+void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
+  static constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packing"};
+  dem::ParticleSet& p = scene.dem.particles;
   const std::string build = sample.choice("build", builders);
-  if (build == "lattice") {
+  if (build == "packing") {
+    read_packing(sample, scene, density, options);
+  } else if (build == "lattice") {
     const Vec3 origin = sample.vec3_or("origin", {}, Range::any(), "m");
     const auto counts = sample.numbers("counts", Range::at_least(1), "1");
     if (counts.size() != 3) sample.fail("counts", "expected three DE counts [nx, ny, nz]");
@@ -53,8 +96,11 @@ void read_sample(CaseNode sample, dem::ParticleSet& p, double density) {
   sample.finish();
 }
 
-void read_bonds(CaseNode bond, dem::DemModel& model) {
-  const double tolerance = bond.number_or("tolerance", 0.01, Range::between(0.0, 1.0), "1");
+// Default bond tolerance: the packing's own (its coordination was checked with it), else 1 %.
+double default_bond_tolerance(const Scene& scene) { return scene.sample ? scene.sample->spec.bond_tolerance : 0.01; }
+
+void read_bonds(CaseNode bond, dem::DemModel& model, double default_tolerance) {
+  const double tolerance = bond.number_or("tolerance", default_tolerance, Range::between(0.0, 1.0), "1");
   dem::BondSet& set = model.add_bond_set(dem::make_bond_set(bond));
   set.name = "bonds";
   bond.finish();
@@ -68,7 +114,7 @@ void read_bonds(CaseNode bond, dem::DemModel& model) {
 // and a group named after it. A bond between two DEs of one material uses that material's bond
 // law and parameters; a bond across materials uses dem.interface. Bond sets are named after
 // their material (and "interface"), so records and outputs say fibre, matrix, interface.
-void read_materials(CaseNode dem_node, dem::DemModel& model) {
+void read_materials(CaseNode dem_node, dem::DemModel& model, double default_tolerance) {
   CaseNode materials = dem_node.child("materials");
   struct Material {
     std::string name;
@@ -114,7 +160,7 @@ void read_materials(CaseNode dem_node, dem::DemModel& model) {
   for (std::size_t i = 0; i < p.size(); ++i) p.groups[i] |= dem::GroupMask{1} << group[material_of[i]];
 
   // One bond set per material with a bond law, and one for the interfaces.
-  const double tolerance = dem_node.number_or("bond_tolerance", 0.01, Range::between(0.0, 1.0), "1");
+  const double tolerance = dem_node.number_or("bond_tolerance", default_tolerance, Range::between(0.0, 1.0), "1");
   std::vector<dem::BondSet*> set_of(list.size(), nullptr);
   for (std::size_t m = 0; m < list.size(); ++m) {
     if (!list[m].bond) continue;
@@ -364,12 +410,12 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       for (const char* single : {"density", "bond"})
         if (dem_node->has(single))
           dem_node->fail(single, "give either dem.materials or dem.density and dem.bond, not both");
-      read_sample(dem_node->child("sample"), model.particles, 1.0);
-      read_materials(*dem_node, model);
+      read_sample(dem_node->child("sample"), scene, 1.0, options);
+      read_materials(*dem_node, model, default_bond_tolerance(scene));
     } else {
       const double density = dem_node->number("density", Range::positive(), "kg/m^3");
-      read_sample(dem_node->child("sample"), model.particles, density);
-      if (auto bond = dem_node->child_if("bond")) read_bonds(*bond, model);
+      read_sample(dem_node->child("sample"), scene, density, options);
+      if (auto bond = dem_node->child_if("bond")) read_bonds(*bond, model, default_bond_tolerance(scene));
     }
     if (auto contact = dem_node->child_if("contact")) {
       double mean_radius = 0.0;

@@ -21,11 +21,13 @@
 //   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s]}
 #pragma once
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/continuum_part.hpp"
 #include "dem/dem_model.hpp"
+#include "dem/sample_file.hpp"
 
 namespace arlequin::app {
 
@@ -67,6 +69,8 @@ struct Scene {
   std::string resolved_case;  // YAML with defaults, as read
   dem::DemModel dem;                           // empty (no DE) without a dem section
   std::unique_ptr<ContinuumPart> continuum;    // null without a continuum section
+  std::optional<dem::SampleRecord> sample;     // with build: packing: its spec and report
+  std::filesystem::path sample_file;           // where the packing is cached
   double end_time = 0.0;      // s
   double dt = 0.0;            // s
   double dt_critical = 0.0;   // s
@@ -80,6 +84,7 @@ struct SceneOptions {
   std::vector<std::string> overrides;  // --set key=value
   std::filesystem::path out_dir;       // --out, empty = from the case
   std::string petsc_options;           // --petsc "...", after the case's own
+  bool rebuild_sample = false;         // build the packing even if its cache file matches
 };
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).

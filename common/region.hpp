@@ -20,18 +20,22 @@ class CaseNode;
 
 struct Box {
   Vec3 lower, upper;
+  bool operator==(const Box&) const = default;
 };
 struct Cylinder {
   Vec3 base, axis;  // axis is unit
   double radius = 0.0;
   double length = -1.0;  // < 0: infinite
+  bool operator==(const Cylinder&) const = default;
 };
 struct Sphere {
   Vec3 center;
   double radius = 0.0;
+  bool operator==(const Sphere&) const = default;
 };
 struct HalfSpace {
   Vec3 point, normal;  // normal is unit
+  bool operator==(const HalfSpace&) const = default;
 };
 
 class Region {
@@ -44,6 +48,7 @@ class Region {
   bool contains(const Vec3& x) const;
   const Shape& shape() const { return shape_; }
   std::string describe() const;
+  bool operator==(const Region&) const = default;
 
  private:
   Shape shape_;

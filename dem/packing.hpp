@@ -44,6 +44,7 @@ struct PackingSpec {
   double min_coordination = 6.0;    // required mean bonds per DE, in the interior
   std::uint64_t seed = 1;
   double bond_tolerance = 0.03;     // a pair is bonded if |x_i - x_j| < (R_i + R_j)(1 + tol)
+  bool operator==(const PackingSpec&) const = default;
 };
 
 struct PackingReport {
