@@ -28,6 +28,7 @@
 //     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
 // Then step() advances both models together and the DEM is finalized by the coupling.
 #pragma once
+#include <array>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -64,6 +65,8 @@ class ContinuumPart {
   virtual bool is_static() const = 0;
   virtual double critical_time_step() const = 0;  // of the coupled system when coupled
   virtual void step(double dt) = 0;    // one explicit step (of both models when coupled)
+  // Sets every node's displacement to H X (rows of H given), before coupling or stepping.
+  virtual void set_affine_displacement(const std::array<Vec3, 3>& H) = 0;
   virtual void solve_static() = 0;     // equilibrium at the current time
   virtual bool has_group(const std::string& name) const = 0;
   virtual Vec3 mean_displacement(const std::string& group) const = 0;  // over the group's nodes, m

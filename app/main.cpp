@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/compare.hpp"
 #include "app/runner.hpp"
 #include "app/scene.hpp"
 #include "app/sweep.hpp"
@@ -29,6 +30,7 @@ constexpr const char* usage_main =
     "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
     "  sweep CASE.yaml   run a case over several values of its keys; table of errors and run times\n"
     "  build-sample CASE.yaml   build the case's packing (dem.sample.build: packing) and save it\n"
+    "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -46,6 +48,13 @@ constexpr const char* usage_check =
     "  prints the case as resolved (with defaults), the DE and bond counts, the critical\n"
     "  time step and the time step that a run would use\n";
 
+constexpr const char* usage_compare =
+    "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--set k=v ...]\n"
+    "  runs both cases (results in DIR/reference and DIR/other, default results/compare), then for\n"
+    "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
+    "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
+    "  compare_<sensor>.png\n";
+
 constexpr const char* usage_sweep =
     "usage: arlequin sweep CASE.yaml --over key.path=v1,v2,... [--over ...] [--out DIR] [--set k=v ...]\n"
     "  runs every combination of the --over values (results in DIR/<run>/, default\n"
@@ -55,6 +64,7 @@ constexpr const char* usage_sweep =
 struct Arguments {
   std::string command;
   std::string case_file;
+  std::string second_case;  // compare
   app::SceneOptions scene;
   long steps = -1;
   std::vector<app::SweepAxis> axes;
@@ -65,7 +75,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -73,7 +83,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -91,7 +101,7 @@ Arguments parse(int argc, char** argv) {
       a.scene.petsc_options += " " + value("a quoted PETSc option string");
     } else if (arg == "--over" && a.command == "sweep") {
       a.axes.push_back(app::parse_sweep_axis(value("key.path=v1,v2,...")));
-    } else if (arg == "--out" && (a.command == "run" || a.command == "sweep")) {
+    } else if (arg == "--out" && (a.command == "run" || a.command == "sweep" || a.command == "compare")) {
       a.scene.out_dir = value("a directory");
     } else if (arg == "--steps" && a.command == "run") {
       const std::string v = value("a number of steps");
@@ -102,11 +112,15 @@ Arguments parse(int argc, char** argv) {
       a.quiet = true;
     } else if (!arg.starts_with("-") && a.case_file.empty()) {
       a.case_file = arg;
+    } else if (!arg.starts_with("-") && a.command == "compare" && a.second_case.empty()) {
+      a.second_case = arg;
     } else {
       throw InputError("arlequin " + a.command + ": unknown option '" + arg + "' (see arlequin " + a.command + " --help)");
     }
   }
   if (!a.help && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
+  if (!a.help && a.command == "compare" && a.second_case.empty())
+    throw InputError("arlequin compare: give two case files (the reference first)");
   if (!a.help && a.command == "sweep" && a.axes.empty()) throw InputError("arlequin sweep: give at least one --over key=v1,v2");
   return a;
 }
@@ -150,10 +164,15 @@ int run(const Arguments& a) {
   std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e  fracture %.6e\n",
               e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture);
   for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
-  for (const auto& c : r.checks)
-    std::printf("check %s %s: %.6e vs %.6e expected (error %.3g %%, tolerance %.3g %%): %s\n", c.check->column.c_str(),
-                app::describe(c.check->kind), c.value, c.check->expected, 100 * c.relative_error,
-                100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
+  for (const auto& c : r.checks) {
+    if (c.check->bounded)
+      std::printf("check %s %s: %.6e within [%.6g, %.6g]: %s\n", c.check->column.c_str(), app::describe(c.check->kind),
+                  c.value, c.check->at_least, c.check->at_most, c.passed ? "ok" : "FAILED");
+    else
+      std::printf("check %s %s: %.6e vs %.6e expected (error %.3g %%, tolerance %.3g %%): %s\n", c.check->column.c_str(),
+                  app::describe(c.check->kind), c.value, c.check->expected, 100 * c.relative_error,
+                  100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
+  }
   std::printf("results: %s\n", std::filesystem::absolute(scene.output.dir).string().c_str());
   return r.all_checks_passed() ? 0 : 5;
 }
@@ -180,6 +199,17 @@ int build_sample(const Arguments& a) {
   return 0;
 }
 
+int compare(const Arguments& a) {
+  std::filesystem::path out = a.scene.out_dir;
+  if (out.empty()) out = "results/compare";
+  app::SceneOptions base = a.scene;
+  base.out_dir.clear();
+  const bool ok = app::run_compare(a.case_file, a.second_case, base, out);
+  std::printf("comparison: %s (compare.csv, compare.json, compare_<sensor>.png)\n",
+              std::filesystem::absolute(out).string().c_str());
+  return ok ? 0 : 3;
+}
+
 int check(const Arguments& a) {
   app::Scene scene = app::build_scene(a.case_file, a.scene);
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
@@ -197,6 +227,7 @@ int main(int argc, char** argv) {
       std::fputs(a.command == "run"     ? usage_run
                  : a.command == "check" ? usage_check
                  : a.command == "sweep" ? usage_sweep
+                 : a.command == "compare" ? usage_compare
                                         : usage_main,
                  stdout);
       return 0;
@@ -204,6 +235,7 @@ int main(int argc, char** argv) {
     if (a.command == "run") return run(a);
     if (a.command == "sweep") return sweep(a);
     if (a.command == "build-sample") return build_sample(a);
+    if (a.command == "compare") return compare(a);
     return check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());

@@ -114,6 +114,8 @@ class Outputs {
         return s.on_continuum ? scene_.continuum->mean_displacement(s.group_name) : scene_.dem.mean_displacement(s.group);
       case Sensor::Kind::velocity:
         return s.on_continuum ? scene_.continuum->mean_velocity(s.group_name) : scene_.dem.mean_velocity(s.group);
+      case Sensor::Kind::energy:
+        return {scene_.dem.group_energy(s.group), 0.0, 0.0};
     }
     return {};
   }
@@ -218,6 +220,7 @@ const char* describe(Check::Kind kind) {
     case Check::Kind::final_value: return "final value";
     case Check::Kind::maximum: return "maximum";
     case Check::Kind::minimum: return "minimum";
+    case Check::Kind::final_over_initial: return "final / initial";
     case Check::Kind::crossing: return "crossing time";
   }
   return "";
@@ -234,6 +237,8 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
     double value = std::numeric_limits<double>::quiet_NaN();
     const bool crossing = c.kind == Check::Kind::crossing;
     if (c.kind == Check::Kind::final_value && series.rows() > 0) value = series.row(series.rows() - 1)[col];
+    if (c.kind == Check::Kind::final_over_initial && series.rows() > 0)
+      value = series.row(series.rows() - 1)[col] / series.row(0)[col];
     for (std::size_t r = 0; (c.kind == Check::Kind::maximum || c.kind == Check::Kind::minimum) && r < series.rows(); ++r) {
       const double x = series.row(r)[col];
       if (r == 0 || (c.kind == Check::Kind::maximum ? x > value : x < value)) value = x;
@@ -245,6 +250,10 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
         value = t0 + (t1 - t0) * a / (a - b);
         break;
       }
+    }
+    if (c.bounded) {
+      out.push_back({&c, value, 0.0, value <= c.at_most && value >= c.at_least});
+      continue;
     }
     const double error = std::abs(value - c.expected) / std::max(std::abs(c.expected), 1e-300);
     out.push_back({&c, value, error, error <= c.tolerance});
@@ -351,9 +360,14 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     j["column"] = c.check->column;
     j["kind"] = describe(c.check->kind);
     j["value"] = c.value;
-    j["expected"] = c.check->expected;
-    j["relative_error"] = c.relative_error;
-    j["tolerance"] = c.check->tolerance;
+    if (c.check->bounded) {
+      if (std::isfinite(c.check->at_most)) j["at_most"] = c.check->at_most;
+      if (std::isfinite(c.check->at_least)) j["at_least"] = c.check->at_least;
+    } else {
+      j["expected"] = c.check->expected;
+      j["relative_error"] = c.relative_error;
+      j["tolerance"] = c.check->tolerance;
+    }
     j["passed"] = c.passed;
     if (!c.check->note.empty()) j["note"] = c.check->note;
     checks.push_back(j);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <limits>
 #include <sstream>
@@ -299,8 +300,49 @@ void read_initial(CaseNode root, dem::DemModel& model) {
   }
 }
 
+// A raised-cosine velocity pulse travelling along d at speed c: with s = (x - center).d,
+//   v(s) = A (1 + cos(2 pi s / lambda)) / 2 for |s| < lambda / 2, else 0, along d,
+//   u(s) = (1/c) int_s^inf v: zero ahead of the pulse, A lambda / (2c) behind it,
+// so that v = -c du/ds (a wave moving towards +d). Displacements are applied after bonding.
+void read_pulse(CaseNode root, dem::DemModel& model) {
+  auto pulse = root.child_if("pulse");
+  if (!pulse) return;
+  const int g = group_of(*pulse, model);
+  const Vec3 d0 = pulse->vec3("direction", Range::any(), "1");
+  if (!(norm(d0) > 0.0)) pulse->fail("direction", "expected a non-zero direction");
+  const Vec3 d = normalized(d0);
+  const Vec3 center = pulse->vec3("center", Range::any(), "m");
+  const double lambda = pulse->number("wavelength", Range::positive(), "m");
+  const double A = pulse->number("amplitude", Range::any(), "m/s");
+  const double c = pulse->number("speed", Range::positive(), "m/s");
+  pulse->finish();
+  const double k = 2.0 * std::numbers::pi / lambda;
+  for (std::uint32_t i : model.members(g)) {
+    const double s = dot(model.particles.position[i] - center, d);
+    const double v = std::abs(s) < 0.5 * lambda ? 0.5 * A * (1.0 + std::cos(k * s)) : 0.0;
+    const double ahead = std::clamp(0.5 * lambda - s, 0.0, lambda);  // length of pulse ahead of s
+    const double sc = std::clamp(s, -0.5 * lambda, 0.5 * lambda);
+    const double u = 0.5 * A / c * (ahead - (std::sin(k * sc) - std::sin(0.5 * k * lambda)) / k);
+    model.particles.velocity[i] += d * v;
+    model.particles.position[i] += d * u;
+  }
+}
+
+// A uniform strain to start from (patch tests): u = H x on every DE (its position moves, its
+// bonds' reference stays) and every continuum node, H the displacement gradient by rows.
+void read_initial_strain(CaseNode root, Scene& scene) {
+  auto section = root.child_if("initial_strain");
+  if (!section) return;
+  const auto rows = section->vec3_list("gradient", Range::any(), "1");
+  if (rows.size() != 3) section->fail("gradient", "expected three rows [[..], [..], [..]] of the displacement gradient");
+  section->finish();
+  const std::array<Vec3, 3> H{rows[0], rows[1], rows[2]};
+  for (Vec3& x : scene.dem.particles.position) x += Vec3{dot(H[0], x), dot(H[1], x), dot(H[2], x)};
+  if (scene.continuum) scene.continuum->set_affine_displacement(H);
+}
+
 void read_sensors(CaseNode root, Scene& scene) {
-  static constexpr std::string_view types[] = {"force", "displacement", "velocity"};
+  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy"};
   static constexpr std::string_view models[] = {"dem", "continuum"};
   const bool has_dem = scene.dem.particles.size() > 0;
   for (CaseNode s : root.list_or_empty("sensors")) {
@@ -311,11 +353,14 @@ void read_sensors(CaseNode root, Scene& scene) {
     for (const Sensor& other : scene.sensors)
       if (other.name == sensor.name) s.fail("name", "sensor '" + sensor.name + "' is defined twice");
     const std::string type = s.choice("type", types);
-    sensor.kind = type == "force" ? Sensor::Kind::force
-                  : type == "displacement" ? Sensor::Kind::displacement : Sensor::Kind::velocity;
+    sensor.kind = type == "force"          ? Sensor::Kind::force
+                  : type == "displacement" ? Sensor::Kind::displacement
+                  : type == "velocity"     ? Sensor::Kind::velocity
+                                           : Sensor::Kind::energy;
     sensor.on_continuum = s.choice_or("on", has_dem ? "dem" : "continuum", models) == "continuum";
     if (sensor.on_continuum) {
       if (!scene.continuum) s.fail("on", "the case has no continuum");
+      if (sensor.kind == Sensor::Kind::energy) s.fail("type", "energy sensors are for DEM groups");
       sensor.group_name = s.string("group");
       if (!scene.continuum->has_group(sensor.group_name))
         s.fail("group", "the continuum mesh has no physical group '" + sensor.group_name + "'");
@@ -325,8 +370,12 @@ void read_sensors(CaseNode root, Scene& scene) {
       sensor.group_name = s.string("group");
       if (sensor.kind == Sensor::Kind::force) scene.dem.watch_reaction(sensor.group);
     }
-    const std::string c = s.choice_or("component", "all", component_names);
-    sensor.component = c == "all" ? -1 : c[0] - 'x';
+    if (sensor.kind == Sensor::Kind::energy) {
+      sensor.component = 0;  // a scalar: one column
+    } else {
+      const std::string c = s.choice_or("component", "all", component_names);
+      sensor.component = c == "all" ? -1 : c[0] - 'x';
+    }
     s.finish();
     scene.sensors.push_back(sensor);
   }
@@ -341,17 +390,27 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
       for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
       c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
     }
-    static constexpr std::string_view statistics[] = {"final", "max", "min"};
+    static constexpr std::string_view statistics[] = {"final", "max", "min", "final_over_initial"};
     if (c.has("crossing")) {
       check.kind = Check::Kind::crossing;
       check.threshold = c.number("crossing", Range::any(), "column unit");
     } else {
       const std::string statistic = c.choice_or("statistic", "final", statistics);
-      check.kind = statistic == "final" ? Check::Kind::final_value
-                   : statistic == "max" ? Check::Kind::maximum : Check::Kind::minimum;
+      check.kind = statistic == "final"  ? Check::Kind::final_value
+                   : statistic == "max"  ? Check::Kind::maximum
+                   : statistic == "min"  ? Check::Kind::minimum
+                                         : Check::Kind::final_over_initial;
     }
-    check.expected = c.number("expected", Range::any(), check.kind == Check::Kind::crossing ? "s" : "column unit");
-    check.tolerance = c.number("tolerance", Range::positive(), "1");
+    const char* unit = check.kind == Check::Kind::crossing ? "s" : "column unit";
+    check.bounded = c.has("at_most") || c.has("at_least");
+    if (check.bounded) {
+      if (c.has("expected")) c.fail("expected", "give either expected and tolerance, or at_most / at_least");
+      check.at_most = c.number_or("at_most", INFINITY, Range::any(), unit);
+      check.at_least = c.number_or("at_least", -INFINITY, Range::any(), unit);
+    } else {
+      check.expected = c.number("expected", Range::any(), unit);
+      check.tolerance = c.number("tolerance", Range::positive(), "1");
+    }
     check.note = c.string_or("note", "");
     c.finish();
     scene.checks.push_back(check);
@@ -435,7 +494,9 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (dem_node) {
     read_groups(root, model);
     read_initial(root, model);
+    read_pulse(root, model);
   }
+  read_initial_strain(root, scene);
   read_sensors(root, scene);
   if (dem_node) read_boundary(root, model);
   finalize_dem(root, scene);

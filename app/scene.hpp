@@ -14,12 +14,17 @@
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
 //   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rotation}]
 //   initial:  [{group, velocity [m/s], angular_velocity [rad/s]}]
-//   sensors:  [{name, type: force | displacement | velocity, group, component: x | y | z | all,
+//   initial_strain: {gradient: [[..], [..], [..]]}: start from u = H x (DEM and continuum)
+//   pulse:    {group, direction, center [m], wavelength [m], amplitude [m/s], speed [m/s]}: a
+//             raised-cosine velocity pulse travelling along `direction` (DEM)
+//   sensors:  [{name, type: force | displacement | velocity | energy, group, component: x | y | z | all,
 //               on: dem | continuum (default: the model the case has; dem if both)}]
-//   checks:   [{column, statistic: final | max | min, expected, tolerance, note}
+//   checks:   [{column, statistic: final | max | min | final_over_initial, expected, tolerance, note}
+//              | {column, statistic, at_most, at_least, note}
 //              | {column, crossing: value, expected: time [s], tolerance, note}]
 //   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s]}
 #pragma once
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -32,7 +37,7 @@
 namespace arlequin::app {
 
 struct Sensor {
-  enum class Kind { force, displacement, velocity };
+  enum class Kind { force, displacement, velocity, energy };  // energy: DEM groups, one column
   std::string name;
   Kind kind = Kind::force;
   bool on_continuum = false;  // else on the DEM
@@ -45,12 +50,14 @@ struct Sensor {
 // the final, largest or smallest value of a column, or the first time a column reaches a value
 // (a wave's arrival). Relative tolerance.
 struct Check {
-  enum class Kind { final_value, maximum, minimum, crossing };
+  enum class Kind { final_value, maximum, minimum, final_over_initial, crossing };
   std::string column;
   Kind kind = Kind::final_value;
   double threshold = 0.0;     // crossing: the value to reach
   double expected = 0.0;      // the value, or the crossing time (s)
-  double tolerance = 0.0;     // relative
+  double tolerance = 0.0;     // relative; or, when expected is not given, bounds:
+  double at_most = INFINITY, at_least = -INFINITY;
+  bool bounded = false;       // true: passes when at_least <= value <= at_most
   std::string note;           // where the expected value comes from
 };
 

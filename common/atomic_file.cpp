@@ -1,5 +1,8 @@
 #include "common/atomic_file.hpp"
 
+#include <fstream>
+#include <iterator>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -49,6 +52,12 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
     std::filesystem::remove(tmp, ec);
     fail(path, "replace", why);
   }
+}
+
+std::string read_text_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot read file");
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace arlequin

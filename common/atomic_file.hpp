@@ -16,4 +16,7 @@ std::filesystem::path temporary_path_for(const std::filesystem::path& path);
 // parent directories. Throws RunError naming the path and the system error.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
+// The whole content of a text file; InputError naming the file if it cannot be read.
+std::string read_text_file(const std::filesystem::path& path);
+
 }  // namespace arlequin

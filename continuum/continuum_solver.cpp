@@ -14,8 +14,7 @@ namespace arlequin::continuum {
 namespace {
 
 // Dunavant degree-4 rule on a triangle (Dunavant, IJNME 21 (1985)), barycentric (a, b, b)
-// permutations; weights sum to 1. Degree 4 integrates P2 traces exactly and natural-neighbour
-// traces well.
+// permutations; weights sum to 1. Degree 4 integrates P2 traces times quadratic tractions exactly.
 constexpr double kTriA[2] = {0.445948490915965, 0.091576213509771};
 constexpr double kTriW[2] = {0.223381589678011, 0.109951743655322};
 
@@ -80,22 +79,25 @@ double ContinuumSolver::prescribed(const Fixed& f, double t) const {
 void ContinuumSolver::add_traction(const std::string& group, VectorFunction traction) {
   const PhysicalGroup& g = mesh_.group(group);
   if (g.dim != 2) throw InputError("traction group '" + group + "' is not a surface group");
-  Traction tr;
-  tr.fn = std::move(traction);
-  for (const auto& tri : g.triangles) {
+  tractions_.push_back({surface_rule(g.triangles), std::move(traction)});
+}
+
+ContinuumSolver::SurfaceRule ContinuumSolver::surface_rule(const std::vector<std::array<int, 3>>& triangles) const {
+  SurfaceRule rule;
+  for (const auto& tri : triangles) {
     const Vec3 &a = nodes()[tri[0]], &b = nodes()[tri[1]], &c = nodes()[tri[2]];
     const double area = 0.5 * norm(cross(b - a, c - a));
     for (int r = 0; r < 2; ++r) {
       const double p = kTriA[r], s = 1.0 - 2.0 * p;
       const std::array<std::array<double, 3>, 3> bary{{{s, p, p}, {p, s, p}, {p, p, s}}};
       for (const auto& l : bary) {
-        tr.x.push_back(l[0] * a + l[1] * b + l[2] * c);
-        tr.w.push_back(kTriW[r] * area);
+        rule.x.push_back(l[0] * a + l[1] * b + l[2] * c);
+        rule.w.push_back(kTriW[r] * area);
       }
     }
   }
-  tr.N = interpolation(tr.x);
-  tractions_.push_back(std::move(tr));
+  rule.N = interpolation(rule.x);
+  return rule;
 }
 
 Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
@@ -130,9 +132,10 @@ void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
 
 void ContinuumSolver::add_external_force(Field& f) const {
   for (const Traction& tr : tractions_) {
-    for (int p = 0; p < tr.N.rows(); ++p) {
-      const Vec3 t = tr.w[p] * tr.fn(tr.x[p], t_);
-      for (InterpolationOperator::InnerIterator it(tr.N, p); it; ++it) {
+    const SurfaceRule& r = tr.rule;
+    for (int p = 0; p < r.N.rows(); ++p) {
+      const Vec3 t = r.w[p] * tr.fn(r.x[p], t_);
+      for (InterpolationOperator::InnerIterator it(r.N, p); it; ++it) {
         double* fj = &f[3 * static_cast<size_t>(it.col())];
         fj[0] += it.value() * t.x;
         fj[1] += it.value() * t.y;
@@ -207,32 +210,50 @@ double ContinuumSolver::critical_time_step() const {
   return 2.0 / std::sqrt(lambda);
 }
 
+// Static solve on PETSC_COMM_WORLD. Rows follow PETSc's default split, by whole nodes
+// (PetscSplitOwnershipBlock, block size 3); rank r assembles the integration points
+// [r nq / size, (r + 1) nq / size), and entries of rows owned elsewhere travel in PETSc's stash at
+// MatAssemblyBegin/End. Without mpirun there is one rank and this is a sequential solve.
 void ContinuumSolver::solve_static(const std::string& petsc_options) {
+  const MPI_Comm comm = PETSC_COMM_WORLD;
+  PetscMPIInt rank, size;  // MPI errors abort (MPI_ERRORS_ARE_FATAL): no codes to check
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
   const PetscInt nn = mesh_.num_nodes(), n = 3 * nn;
-  // Block sparsity: nodes sharing an integration point are coupled.
-  std::vector<std::vector<int>> adj(nn);
+  PetscInt n_local = PETSC_DECIDE, n_global = n, row_end;
+  check(PetscSplitOwnershipBlock(comm, 3, &n_local, &n_global), "PetscSplitOwnershipBlock");
+  MPI_Scan(&n_local, &row_end, 1, MPIU_INT, MPI_SUM, comm);
+  const int node0 = static_cast<int>((row_end - n_local) / 3), node1 = static_cast<int>(row_end / 3);
+
+  // Block sparsity of the local rows: nodes sharing an integration point are coupled.
+  std::vector<std::vector<int>> adj(node1 - node0);
   const int nq = static_cast<int>(points_.x.size());
   for (int q = 0; q < nq; ++q)
-    for (int a = points_.offset[q]; a < points_.offset[q + 1]; ++a)
-      for (int b = points_.offset[q]; b < points_.offset[q + 1]; ++b) adj[points_.node[a]].push_back(points_.node[b]);
-  std::vector<PetscInt> nnz(n);
-  for (int i = 0; i < nn; ++i) {
+    for (int a = points_.offset[q]; a < points_.offset[q + 1]; ++a) {
+      const int i = points_.node[a];
+      if (i < node0 || i >= node1) continue;
+      for (int b = points_.offset[q]; b < points_.offset[q + 1]; ++b) adj[i - node0].push_back(points_.node[b]);
+    }
+  std::vector<PetscInt> d_nnz(node1 - node0), o_nnz(node1 - node0);
+  for (int i = 0; i < node1 - node0; ++i) {
     auto& a = adj[i];
     std::sort(a.begin(), a.end());
     a.erase(std::unique(a.begin(), a.end()), a.end());
-    for (int c = 0; c < 3; ++c) nnz[3 * i + c] = 3 * static_cast<PetscInt>(a.size());
+    d_nnz[i] = static_cast<PetscInt>(std::count_if(a.begin(), a.end(), [&](int j) { return j >= node0 && j < node1; }));
+    o_nnz[i] = static_cast<PetscInt>(a.size()) - d_nnz[i];
     std::vector<int>().swap(a);
   }
 
   Mat K;
-  check(MatCreate(PETSC_COMM_SELF, &K), "MatCreate");
-  check(MatSetSizes(K, n, n, n, n), "MatSetSizes");
-  check(MatSetType(K, MATSEQAIJ), "MatSetType");
+  check(MatCreate(comm, &K), "MatCreate");
+  check(MatSetSizes(K, n_local, n_local, n, n), "MatSetSizes");
+  check(MatSetType(K, MATAIJ), "MatSetType");
   check(MatSetBlockSize(K, 3), "MatSetBlockSize");
-  check(MatSeqAIJSetPreallocation(K, 0, nnz.data()), "MatSeqAIJSetPreallocation");
+  check(MatXAIJSetPreallocation(K, 3, d_nnz.data(), o_nnz.data(), nullptr, nullptr), "MatXAIJSetPreallocation");
   std::vector<PetscInt> idx;
-  std::vector<PetscScalar> ke;
-  for (int q = 0; q < nq; ++q) {
+  const int q0 = static_cast<int>(static_cast<long long>(nq) * rank / size);
+  const int q1 = static_cast<int>(static_cast<long long>(nq) * (rank + 1) / size);
+  for (int q = q0; q < q1; ++q) {
     const int b0 = points_.offset[q], m = points_.offset[q + 1] - b0;
     const Stiffness C = point_weight_[q] * materials_[points_.material[q]].C;
     Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, 3 * m);
@@ -253,22 +274,25 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   check(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
 
+  // Right-hand side, start vector with the prescribed values, and the local fixed rows.
   Field f_ext(u_.size(), 0.0);
   add_external_force(f_ext);
   Vec b, x, coords;
-  check(VecCreateSeq(PETSC_COMM_SELF, n, &b), "VecCreateSeq");
-  check(VecDuplicate(b, &x), "VecDuplicate");
+  check(MatCreateVecs(K, &x, &b), "MatCreateVecs");
+  PetscInt lo, hi;
+  check(VecGetOwnershipRange(b, &lo, &hi), "VecGetOwnershipRange");
   PetscScalar* pb;
   PetscScalar* px;
   check(VecGetArray(b, &pb), "VecGetArray");
   check(VecGetArray(x, &px), "VecGetArray");
-  std::vector<PetscInt> rows;
-  for (PetscInt d = 0; d < n; ++d) {
-    pb[d] = f_ext[d];
-    px[d] = 0.0;
+  for (PetscInt d = lo; d < hi; ++d) {
+    pb[d - lo] = f_ext[d];
+    px[d - lo] = 0.0;
   }
+  std::vector<PetscInt> rows;
   for (const Fixed& f : fixed_) {
-    px[f.dof] = prescribed(f, t_);
+    if (f.dof < lo || f.dof >= hi) continue;
+    px[f.dof - lo] = prescribed(f, t_);
     rows.push_back(f.dof);
   }
   check(VecRestoreArray(b, &pb), "VecRestoreArray");
@@ -284,15 +308,11 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(MatZeroRowsColumns(K, static_cast<PetscInt>(rows.size()), rows.data(), dsum / n, x, b), "MatZeroRowsColumns");
 
   // Rigid-body near-null space helps algebraic multigrid on elasticity.
-  check(VecCreateSeq(PETSC_COMM_SELF, n, &coords), "VecCreateSeq");
+  check(VecDuplicate(b, &coords), "VecDuplicate");
   check(VecSetBlockSize(coords, 3), "VecSetBlockSize");
   PetscScalar* pc;
   check(VecGetArray(coords, &pc), "VecGetArray");
-  for (PetscInt i = 0; i < nn; ++i) {
-    pc[3 * i] = nodes()[i].x;
-    pc[3 * i + 1] = nodes()[i].y;
-    pc[3 * i + 2] = nodes()[i].z;
-  }
+  for (PetscInt d = lo; d < hi; ++d) pc[d - lo] = nodes()[d / 3][static_cast<int>(d % 3)];
   check(VecRestoreArray(coords, &pc), "VecRestoreArray");
   MatNullSpace rigid;
   check(MatNullSpaceCreateRigidBody(coords, &rigid), "MatNullSpaceCreateRigidBody");
@@ -307,7 +327,7 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(PetscOptionsPush(db), "PetscOptionsPush");
   KSP ksp;
   KSPConvergedReason reason;
-  check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
+  check(KSPCreate(comm, &ksp), "KSPCreate");
   check(KSPSetOperators(ksp, K, K), "KSPSetOperators");
   check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   check(KSPSolve(ksp, b, x), "KSPSolve");
@@ -315,10 +335,18 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(PetscOptionsPop(), "PetscOptionsPop");
   check(PetscOptionsDestroy(&db), "PetscOptionsDestroy");
 
+  // Every rank gets the whole solution.
+  VecScatter to_all;
+  Vec x_all;
+  check(VecScatterCreateToAll(x, &to_all, &x_all), "VecScatterCreateToAll");
+  check(VecScatterBegin(to_all, x, x_all, INSERT_VALUES, SCATTER_FORWARD), "VecScatterBegin");
+  check(VecScatterEnd(to_all, x, x_all, INSERT_VALUES, SCATTER_FORWARD), "VecScatterEnd");
   const PetscScalar* sol;
-  check(VecGetArrayRead(x, &sol), "VecGetArrayRead");
+  check(VecGetArrayRead(x_all, &sol), "VecGetArrayRead");
   std::copy(sol, sol + n, u_.begin());
-  check(VecRestoreArrayRead(x, &sol), "VecRestoreArrayRead");
+  check(VecRestoreArrayRead(x_all, &sol), "VecRestoreArrayRead");
+  VecScatterDestroy(&to_all);
+  VecDestroy(&x_all);
   KSPDestroy(&ksp);
   MatNullSpaceDestroy(&rigid);
   VecDestroy(&coords);

@@ -13,12 +13,16 @@
 //  - `interpolation(points)` returns the sparse operator N (rows: points, columns: nodes) with
 //    u(point_p) = sum_I N(p, I) u_I per component; points outside the body are an InputError.
 //  - Essential BCs act on named physical groups and fix chosen components to g(X, t); loads are
-//    tractions on named boundary groups, integrated with the method's own shape functions.
+//    tractions on named boundary groups, integrated with the method's own shape functions and
+//    surface rule (`surface_rule`).
 //  - Explicit central difference = velocity Verlet: kick(dt/2), drift(dt), compute_forces(),
 //    kick(dt/2) (`step`). The coupled step of DESIGN section 2 calls the three parts itself.
 //    Stable for dt < critical_time_step() = 2 / omega_max of M^-1 K (power iteration).
-//  - `solve_static` assembles K into a PETSc Mat and solves K u = f with KSP; the PETSc option
-//    string (e.g. "-ksp_type cg -pc_type gamg") overrides the defaults "cg + gamg, rtol 1e-12".
+//  - `solve_static` assembles K into a PETSc Mat distributed over PETSC_COMM_WORLD (each rank
+//    adds its share of the integration points; one rank when run without mpirun) and solves
+//    K u = f with KSP; the PETSc option string (e.g. "-ksp_type cg -pc_type gamg") overrides the
+//    defaults "cg + gamg, rtol 1e-12". The solution is gathered on every rank: everything else
+//    (explicit steps, interpolation) is replicated, so every rank must make the same calls.
 //  - Mesh and input problems are InputError; failed solves and non-finite states are RunError.
 #pragma once
 #include <Eigen/Sparse>
@@ -113,6 +117,16 @@ class ContinuumSolver {
   void finish_setup();
   virtual std::vector<double> weighted_lumped_mass(const ScalarFunction& alpha) const = 0;
 
+  // Quadrature of surface integrals over boundary triangles (vertex triples of the mesh): points,
+  // weights (areas) and the interpolation operator at the points. Default: Dunavant degree 4 on
+  // every triangle.
+  struct SurfaceRule {
+    std::vector<Vec3> x;
+    std::vector<double> w;
+    InterpolationOperator N;
+  };
+  virtual SurfaceRule surface_rule(const std::vector<std::array<int, 3>>& triangles) const;
+
   Mesh mesh_;
   std::vector<Material> materials_;
   std::vector<int> tet_material_;  // per tetrahedron, index into materials_
@@ -120,9 +134,7 @@ class ContinuumSolver {
 
  private:
   struct Traction {
-    InterpolationOperator N;  // at the quadrature points
-    std::vector<Vec3> x;
-    std::vector<double> w;
+    SurfaceRule rule;
     VectorFunction fn;
   };
   struct Fixed {

@@ -88,6 +88,15 @@ class BondSet {
     zero_stiffness(b);
   }
   std::span<const std::uint8_t> broken() const { return broken_; }
+  // Adds half of every bond's elastic energy to each of its DEs (J): where the energy is, for
+  // energy sensors over a group. Output-time use (one virtual call per bond).
+  void add_energy_per_particle(const ParticleSet& p, std::span<double> energy) const {
+    for (std::size_t b = 0; b < size(); ++b) {
+      const double half = 0.5 * bond_energy(b, p);
+      energy[first_[b]] += half;
+      energy[second_[b]] += half;
+    }
+  }
 
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }

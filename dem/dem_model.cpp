@@ -372,6 +372,18 @@ Vec3 DemModel::mean_displacement(int group) const {
   return group_mean(group, [&](std::size_t i) { return particles.position[i] - particles.reference[i]; });
 }
 
+double DemModel::group_energy(int group) const {
+  std::vector<double> bond_energy(particles.size(), 0.0);
+  for (const auto& set : bond_sets_) set->add_energy_per_particle(particles, bond_energy);
+  const GroupMask bit = GroupMask{1} << group;
+  double e = 0.0;
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    if (particles.groups[i] & bit)
+      e += bond_energy[i] + 0.5 * (particles.mass(i) * norm2(particles.velocity[i]) +
+                                   particles.inertia(i) * norm2(particles.angular_velocity[i]));
+  return e;
+}
+
 Vec3 DemModel::mean_velocity(int group) const {
   return group_mean(group, [&](std::size_t i) { return particles.velocity[i]; });
 }

@@ -103,6 +103,8 @@ class DemModel {
   Vec3 reaction_on(int group) const { return reaction_[group]; }
   Vec3 mean_displacement(int group) const;  // m
   Vec3 mean_velocity(int group) const;      // m/s
+  // Kinetic energy of the group's DEs plus half the energy of each of their bonds, J.
+  double group_energy(int group) const;
   // Both throw RunError naming the step, the DE and the likely cause. check_finite: any
   // non-finite velocity (cheap, meant for every step); check_energy: kinetic energy above
   // energy_limit (J), a blow-up.

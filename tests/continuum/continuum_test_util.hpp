@@ -1,5 +1,6 @@
-// Shared set-up for the continuum tests: mesh paths, settings, affine fields.
+// Shared set-up for the continuum tests: mesh paths, settings, affine fields, patch tests.
 #pragma once
+#include <algorithm>
 #include <string>
 
 #include "continuum/registry.hpp"
@@ -23,6 +24,36 @@ inline Vec3 affine(const Vec3& x) {
 inline Voigt affine_strain() {
   Voigt e;
   e << 2e-3, 1.5e-3, 1.1e-3, 0.9e-3 - 0.4e-3, 0.5e-3 - 0.3e-3, -1e-3 + 0.7e-3;
+  return e;
+}
+
+// Affine patch test on a solver of unit_cube.geo with material `mat`: the affine field is
+// prescribed on the whole boundary or, with `traction`, on xmin only while the five other faces
+// carry its traction sigma n. Returns the largest nodal displacement error relative to the
+// field's size (3e-3) and the largest relative stress error at the integration points; both are
+// round-off for a method that passes the test.
+struct PatchErrors {
+  double displacement = 0, stress = 0;
+};
+inline PatchErrors patch_test(ContinuumSolver& s, const Material& mat, bool traction) {
+  const Voigt sigma = mat.C * affine_strain();
+  s.fix(traction ? "xmin" : "boundary", {true, true, true}, [](const Vec3& x, double) { return affine(x); });
+  if (traction) {
+    const std::pair<const char*, Vec3> faces[] = {
+        {"xmax", {1, 0, 0}}, {"ymin", {0, -1, 0}}, {"ymax", {0, 1, 0}}, {"zmin", {0, 0, -1}}, {"zmax", {0, 0, 1}}};
+    for (const auto& [group, n] : faces) {
+      const Vec3 t{sigma[0] * n.x + sigma[5] * n.y + sigma[4] * n.z, sigma[5] * n.x + sigma[1] * n.y + sigma[3] * n.z,
+                   sigma[4] * n.x + sigma[3] * n.y + sigma[2] * n.z};
+      s.add_traction(group, [t](const Vec3&, double) { return t; });
+    }
+  }
+  s.solve_static("-ksp_type preonly -pc_type lu");
+  PatchErrors e;
+  for (int n = 0; n < s.num_nodes(); ++n) {
+    const Vec3 u = affine(s.nodes()[n]);
+    for (int c = 0; c < 3; ++c) e.displacement = std::max(e.displacement, std::abs(s.displacement()[3 * n + c] - u[c]) / 3e-3);
+  }
+  for (const Voigt& st : s.point_stress()) e.stress = std::max(e.stress, (st - sigma).norm() / sigma.norm());
   return e;
 }
 

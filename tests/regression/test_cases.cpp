@@ -110,6 +110,39 @@ TEST(Cases, LatticeBarFailsAtTheBondStrength) {
   EXPECT_NEAR(energy_balance(s), 0.0, 1e-2 * s.at("energies").at("external_work").as_number());
 }
 
+// R6 on a 3D bar: the pulse leaves the DEM through the overlap; the energy left behind is R.
+TEST(Cases, WaveBarCoupledTransmitsThePulse) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  // Default (h = 4a, lambda = 1.6 lambda_c): the case's own check, R <= 0.5 %.
+  const Json coarse = run_case("wave_bar_coupled");
+  EXPECT_TRUE(coarse.at("checks").as_array().at(0).at("passed").as_bool());
+  // Matched (h = a), lambda = 20a >= 5a: R <= 0.3 %.
+  const Json matched = run_case("wave_bar_coupled", "--set continuum.mesh.file=../../meshes/coupled_bar_h1.geo");
+  EXPECT_LE(matched.at("checks").as_array().at(0).at("value").as_number(), 0.003);
+}
+
+TEST(Cli, CompareReportsErrorAndSpeedUp) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("compare");
+  const auto r = test::run_arlequin("compare " + cases + "wave_bar_dem/case.yaml " + cases + "wave_bar_coupled/case.yaml --out " +
+                                        out.string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json c = Json::parse(test::read_text(out / "compare.json"));
+  EXPECT_EQ(c.at("reference").at("particles").as_integer(), 2975);
+  EXPECT_EQ(c.at("other").at("particles").as_integer(), 775);
+  EXPECT_GT(c.at("speedup_compute").as_number(), 0.0);  // the figure itself is a benchmark, not a test
+  const auto& sensors = c.at("sensors").as_array();
+  ASSERT_EQ(sensors.size(), 2u);
+  EXPECT_EQ(sensors[0].at("sensor").as_string(), "E_dem_side");
+  EXPECT_LT(sensors[1].at("rms_relative_difference").as_number(), 0.2);  // u_probe
+  EXPECT_TRUE(std::filesystem::exists(out / "compare_u_probe.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "compare.csv"));
+}
+
 TEST(Cli, VersionHelpAndCheck) {
   EXPECT_EQ(test::run_arlequin("--version", "stdout").exit_code, 0);
   EXPECT_NE(test::run_arlequin("run --help", "stdout").output.find("--steps"), std::string::npos);

@@ -51,3 +51,17 @@ TEST(Materials, ASecondMaterialWithoutRegionIsRefused) {
 
 }  // namespace
 }  // namespace arlequin
+
+namespace arlequin {
+namespace {
+
+// initial_strain puts every DE on u = H x (bonds keep their unstrained reference): a lattice
+// held on that field at both ends is in exact equilibrium and must not move.
+TEST(InitialStrain, AHeldUniformStrainIsAnExactStaticState) {
+  const auto out = test::scratch_dir("dem_patch");
+  const auto r = test::run_arlequin("run " + data + "dem_patch.yaml --quiet --out " + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;  // the case's checks: no motion, u = eps x
+}
+
+}  // namespace
+}  // namespace arlequin

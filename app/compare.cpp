@@ -1,0 +1,167 @@
+#include "app/compare.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/runner.hpp"
+#include "common/atomic_file.hpp"
+#include "common/error.hpp"
+#include "common/json.hpp"
+#include "common/png_plot.hpp"
+
+namespace arlequin::app {
+namespace {
+
+struct Run {
+  std::string name;
+  std::vector<std::string> sensors;  // the case's sensor columns
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;  // series.csv
+  double setup = 0.0, loop = 0.0, output = 0.0;
+  std::size_t particles = 0;
+  long nodes = 0, steps = 0;
+  bool ok = true;
+
+  double compute_seconds() const { return loop - output; }
+  std::vector<double> column(const std::string& name_) const {
+    const std::size_t c = std::find(columns.begin(), columns.end(), name_) - columns.begin();
+    std::vector<double> out;
+    for (const auto& r : rows) out.push_back(r[c]);
+    return out;
+  }
+};
+
+Run execute(const std::filesystem::path& case_file, SceneOptions options, const std::filesystem::path& out) {
+  options.out_dir = out;
+  const auto t0 = std::chrono::steady_clock::now();
+  Scene scene = build_scene(case_file, options);
+  RunOptions run_options;
+  run_options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Run run;
+  run.name = scene.name;
+  run.sensors = sensor_columns(scene);
+  run.particles = scene.dem.particles.size();
+  Json counts = Json::object();
+  if (scene.continuum) scene.continuum->describe(counts);
+  if (const Json* n = counts.find("continuum_nodes")) run.nodes = long(n->as_integer());
+  try {
+    run_scene(scene, run_options);
+  } catch (const RunError&) {
+    run.ok = false;
+  }
+  const Json summary = Json::parse(read_text_file(out / "summary.json"));
+  run.setup = run_options.setup_seconds;
+  run.loop = summary.at("wall_time").at("time_loop").as_number();
+  run.output = summary.at("wall_time").at("output").as_number();
+  run.steps = long(summary.at("steps").as_integer());
+  // series.csv: a header, then rows of numbers.
+  std::stringstream csv(read_text_file(out / "series.csv"));
+  std::string line;
+  std::getline(csv, line);
+  std::stringstream header(line);
+  for (std::string c; std::getline(header, c, ',');) run.columns.push_back(c);
+  while (std::getline(csv, line)) {
+    std::stringstream cells(line);
+    std::vector<double> row;
+    for (std::string c; std::getline(cells, c, ',');) row.push_back(std::stod(c));
+    run.rows.push_back(row);
+  }
+  return run;
+}
+
+// b(t) at the times ta, linear between b's own samples (held beyond its ends).
+std::vector<double> resample(const std::vector<double>& tb, const std::vector<double>& b, const std::vector<double>& ta) {
+  std::vector<double> out;
+  for (double t : ta) {
+    const auto it = std::lower_bound(tb.begin(), tb.end(), t);
+    if (it == tb.begin()) out.push_back(b.front());
+    else if (it == tb.end()) out.push_back(b.back());
+    else {
+      const std::size_t k = it - tb.begin();
+      const double w = (t - tb[k - 1]) / (tb[k] - tb[k - 1]);
+      out.push_back((1 - w) * b[k - 1] + w * b[k]);
+    }
+  }
+  return out;
+}
+
+Json describe_run(const Run& r) {
+  Json j = Json::object();
+  j["name"] = r.name;
+  j["particles"] = r.particles;
+  j["continuum_nodes"] = r.nodes;
+  j["steps"] = r.steps;
+  j["setup_seconds"] = r.setup;
+  j["compute_seconds"] = r.compute_seconds();
+  j["output_seconds"] = r.output;
+  j["completed"] = r.ok;
+  return j;
+}
+
+}  // namespace
+
+bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
+                 const SceneOptions& base, const std::filesystem::path& out_dir) {
+  const Run a = execute(reference_case, base, out_dir / "reference");
+  const Run b = execute(other_case, base, out_dir / "other");
+  // Shared sensor columns (the energy totals mean different things for a DEM and a coupled run).
+  std::vector<std::string> shared;
+  for (const std::string& name : a.sensors)
+    if (std::find(b.sensors.begin(), b.sensors.end(), name) != b.sensors.end()) shared.push_back(name);
+  if (shared.empty())
+    throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
+
+  const auto ta = a.column("time"), tb = b.column("time");
+  Json sensors = Json::array();
+  std::string csv = "sensor,max_relative_difference,rms_relative_difference\n";
+  std::printf("| sensor | max rel. difference | RMS rel. difference |\n|---|---|---|\n");
+  for (const std::string& name : shared) {
+    const auto va = a.column(name), vb = resample(tb, b.column(name), ta);
+    double max_diff = 0, max_ref = 0, sum_diff = 0, sum_ref = 0;
+    for (std::size_t k = 0; k < va.size(); ++k) {
+      const double d = vb[k] - va[k];
+      max_diff = std::max(max_diff, std::abs(d));
+      max_ref = std::max(max_ref, std::abs(va[k]));
+      sum_diff += d * d;
+      sum_ref += va[k] * va[k];
+    }
+    const double max_rel = max_diff / std::max(max_ref, 1e-300), rms_rel = std::sqrt(sum_diff / std::max(sum_ref, 1e-300));
+    Json j = Json::object();
+    j["sensor"] = name;
+    j["max_relative_difference"] = max_rel;
+    j["rms_relative_difference"] = rms_rel;
+    sensors.push_back(j);
+    char row[256];
+    std::snprintf(row, sizeof row, "%s,%.6g,%.6g\n", name.c_str(), max_rel, rms_rel);
+    csv += row;
+    std::printf("| %s | %.3g %% | %.3g %% |\n", name.c_str(), 100 * max_rel, 100 * rms_rel);
+    PlotSpec plot;
+    plot.title = name + ": " + b.name + " against " + a.name;
+    plot.x_label = "time [s]";
+    plot.y_label = name;
+    plot.series = {{a.name, ta, va}, {b.name, tb, b.column(name)}};
+    write_png_plot(out_dir / ("compare_" + name + ".png"), plot);
+  }
+  const double speedup = a.compute_seconds() / std::max(b.compute_seconds(), 1e-12);
+  std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", a.name.c_str(),
+              a.particles, a.nodes, a.steps, a.compute_seconds(), a.setup, a.output);
+  std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", b.name.c_str(),
+              b.particles, b.nodes, b.steps, b.compute_seconds(), b.setup, b.output);
+  std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
+
+  Json report = Json::object();
+  report["reference"] = describe_run(a);
+  report["other"] = describe_run(b);
+  report["speedup_compute"] = speedup;
+  report["sensors"] = sensors;
+  write_file_atomically(out_dir / "compare.csv", csv);
+  write_json_atomically(out_dir / "compare.json", report);
+  return a.ok && b.ok;
+}
+
+}  // namespace arlequin::app

@@ -1,0 +1,20 @@
+// `arlequin compare`: runs two cases that share sensors (e.g. pure DEM and coupled) and
+// reports, for each shared sensor column, the second run's difference to the first (the
+// reference) against both runs' run times and sizes: the user's "error against run time" view.
+//
+// Differences, with b interpolated linearly onto a's output times:
+//   max relative = max |b - a| / max |a|,  RMS relative = rms(b - a) / rms(a).
+// Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors) and one PNG
+// per sensor overlaying both time histories, into the output folder (atomically).
+#pragma once
+#include <filesystem>
+
+#include "app/scene.hpp"
+
+namespace arlequin::app {
+
+// Returns false if a run failed. InputError when the cases share no sensor column.
+bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
+                 const SceneOptions& base, const std::filesystem::path& out_dir);
+
+}  // namespace arlequin::app
