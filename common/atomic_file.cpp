@@ -1,5 +1,7 @@
 #include "common/atomic_file.hpp"
 
+#include <unistd.h>
+
 #include <fstream>
 #include <iterator>
 
@@ -22,8 +24,10 @@ namespace {
 }  // namespace
 
 std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
+  // The process id keeps writers apart (e.g. MPI ranks writing the same result file): each
+  // renames its own complete copy into place.
   std::filesystem::path tmp = path;
-  tmp += ".tmp";
+  tmp += ".tmp." + std::to_string(::getpid());
   return tmp;
 }
 

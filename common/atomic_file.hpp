@@ -8,7 +8,7 @@
 namespace arlequin {
 
 // The sibling file a new version of `path` is written to before it replaces `path`:
-// `path` + ".tmp". Same directory, so the final rename never crosses file systems.
+// `path` + ".tmp.<pid>". Same directory, so the final rename never crosses file systems.
 std::filesystem::path temporary_path_for(const std::filesystem::path& path);
 
 // Writes `content` to temporary_path_for(path), closes it, then renames it over `path`

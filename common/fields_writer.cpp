@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <unistd.h>
 #include <charconv>
 #include <cstdio>
 #include <numeric>
@@ -125,7 +126,7 @@ struct FieldsWriter::Column {
 
 FieldsWriter::FieldsWriter(std::filesystem::path h5_path, std::filesystem::path xdmf_path)
     : h5_path_(std::move(h5_path)), part_path_(h5_path_), xdmf_path_(std::move(xdmf_path)) {
-  part_path_ += ".part";
+  part_path_ += ".part." + std::to_string(::getpid());  // one per writing process (MPI ranks)
   h5_reference_ = xml_escaped(std::filesystem::absolute(h5_path_)
                                   .lexically_relative(std::filesystem::absolute(xdmf_path_).parent_path())
                                   .generic_string());

@@ -1,5 +1,6 @@
 // Output writers: atomic files, CSV series, JSON summaries and HDF5/XDMF fields.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <hdf5.h>
 
 #include <cmath>
@@ -49,7 +50,7 @@ TEST_F(OutputTest, AtomicWriteReplacesContentAndLeavesNoTemporary) {
   write_file_atomically(path, "first version, rather long\n");
   write_file_atomically(path, "second\n");
   EXPECT_EQ(read_text(path), "second\n");
-  EXPECT_EQ(temporary_path_for(path), dir_ / "sub" / "file.txt.tmp");
+  EXPECT_EQ(temporary_path_for(path), dir_ / "sub" / ("file.txt.tmp." + std::to_string(::getpid())));
   EXPECT_FALSE(fs::exists(temporary_path_for(path)));
   EXPECT_THROW(write_file_atomically(path / "below_a_file", "x"), RunError);
 }
@@ -189,13 +190,13 @@ TEST_F(OutputTest, FieldsWriterParticlesAndBonds) {
       const std::vector<std::int64_t> out_of_range = {0, 3};
       EXPECT_THROW(writer.add_grid("broken", positions, FieldsWriter::CellKind::Line, out_of_range), std::logic_error);
       writer.end_frame();
-      EXPECT_TRUE(fs::exists(fs::path(h5) += ".part"));
+      EXPECT_TRUE(fs::exists(fs::path(h5) += ".part." + std::to_string(::getpid())));
     }
     EXPECT_THROW(writer.add_grid("late", {}, FieldsWriter::CellKind::Vertex, {}), std::logic_error);
     EXPECT_EQ(writer.frames(), 2u);
     writer.close();
   }
-  EXPECT_FALSE(fs::exists(fs::path(h5) += ".part"));
+  EXPECT_FALSE(fs::exists(fs::path(h5) += ".part." + std::to_string(::getpid())));
   ASSERT_TRUE(fs::exists(h5));
 
   const hid_t file = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);

@@ -1,5 +1,6 @@
 // Dense random packings (seed "first challenge", DESIGN.md section 3) and sample files.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <hdf5.h>
 
 #include <algorithm>
@@ -134,7 +135,7 @@ TEST_F(SampleFileTest, TenThousandDesInABoxAreDenseIsotropicAndSaved) {
   p.groups[7] = 0b101;
   const fs::path file = dir_ / "sub" / "sample.h5";
   save_sample(file, p, spec, report);
-  EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
+  EXPECT_FALSE(fs::exists(file.string() + ".tmp." + std::to_string(::getpid())));
   ParticleSet q;
   const SampleRecord record = load_sample(file, q, 1750.0);
   EXPECT_TRUE(same_bits(q.position, p.position));

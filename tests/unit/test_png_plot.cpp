@@ -1,5 +1,6 @@
 // PNG plots: tick choice, and written files parsed back (chunks, CRCs, zlib stream, pixels).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -208,7 +209,7 @@ TEST_F(PngPlot, TwoAxesPlotIsValidPngWithBothColours) {
   spec.series = {broken, stress};
   const fs::path path = dir_ / "two_axes.png";
   write_png_plot(path, spec);
-  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp." + std::to_string(::getpid())));
 
   const Image image = read_png(path);
   ASSERT_EQ(image.width, spec.width);
