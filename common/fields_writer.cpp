@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include "common/hdf5_handle.hpp"
+
 #include <unistd.h>
 #include <charconv>
 #include <cstdio>
@@ -35,23 +37,7 @@ T checked(T result, const std::filesystem::path& file, std::string_view action, 
   return result;
 }
 
-// Owns one HDF5 id and releases it with the matching close function.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, -1)), close_(other.close_) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  Handle& operator=(Handle&&) = delete;
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using Handle = Hdf5Handle;
 
 // Link creation properties that create missing intermediate groups, so a dataset path
 // like /frames/000003/particles/point/velocity can be written in one call.

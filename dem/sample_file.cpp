@@ -2,6 +2,8 @@
 
 #include <hdf5.h>
 
+#include "common/hdf5_handle.hpp"
+
 #include <array>
 #include <string>
 #include <string_view>
@@ -23,21 +25,7 @@ constexpr int format_version = 1;
 // Positions are written as n x 3 doubles without copying.
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && std::is_standard_layout_v<Vec3>);
 
-// Owns one HDF5 id and releases it with the matching close function.
-class Handle {
- public:
-  Handle(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  operator hid_t() const { return id_; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using Handle = Hdf5Handle;
 
 // One sample file being written or read. HDF5 reports failures as negative ids and statuses
 // (its own error printing is silenced, as in FieldsWriter); check() turns them into errors

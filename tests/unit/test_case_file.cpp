@@ -3,6 +3,8 @@
 #include "common/case_file.hpp"
 
 #include <gtest/gtest.h>
+
+#include "support/scratch_dir.hpp"
 #include <yaml-cpp/yaml.h>
 
 #include <array>
@@ -17,17 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class CaseFileTest : public ::testing::Test {
+class CaseFileTest : public test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("arlequin_case_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const std::string& text, const std::string& name = "case.yaml") {
     const fs::path file = dir_ / name;
     fs::create_directories(file.parent_path());
@@ -37,8 +30,6 @@ class CaseFileTest : public ::testing::Test {
   CaseFile load(const std::string& text, const std::vector<std::string>& overrides = {}) {
     return CaseFile::load(write(text), overrides);
   }
-
-  fs::path dir_;
 };
 
 // The message of the InputError thrown by `f` ("" if none was thrown).

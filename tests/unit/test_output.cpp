@@ -1,5 +1,7 @@
 // Output writers: atomic files, CSV series, JSON summaries and HDF5/XDMF fields.
 #include <gtest/gtest.h>
+
+#include "support/scratch_dir.hpp"
 #include <unistd.h>
 #include <hdf5.h>
 
@@ -24,19 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A fresh directory per test, removed afterwards.
-class OutputTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("arlequin_output_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path dir_;
-};
+class OutputTest : public test::ScratchDirTest {};
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

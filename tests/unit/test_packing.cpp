@@ -1,5 +1,7 @@
 // Dense random packings (seed "first challenge", DESIGN.md section 3) and sample files.
 #include <gtest/gtest.h>
+
+#include "support/scratch_dir.hpp"
 #include <unistd.h>
 #include <hdf5.h>
 
@@ -73,19 +75,7 @@ void expect_dense_isotropic(const ParticleSet& p, const PackingSpec& spec, const
   }
 }
 
-// A fresh directory per test, removed afterwards.
-class SampleFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("arlequin_sample_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path dir_;
-};
+class SampleFileTest : public test::ScratchDirTest {};
 
 // ~10k DEs, the size of the seed's smaller REV samples; a few seconds.
 TEST_F(SampleFileTest, TenThousandDesInABoxAreDenseIsotropicAndSaved) {

@@ -1,5 +1,7 @@
 // PNG plots: tick choice, and written files parsed back (chunks, CRCs, zlib stream, pixels).
 #include <gtest/gtest.h>
+
+#include "support/scratch_dir.hpp"
 #include <unistd.h>
 
 #include <array>
@@ -21,18 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class PngPlot : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("arlequin_png_plot_" + std::string(info->name()) + "_" + std::to_string(std::random_device{}()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path dir_;
-};
+class PngPlot : public test::ScratchDirTest {};
 
 // --- An independent reader for the subset of PNG the writer produces -------------------
 
