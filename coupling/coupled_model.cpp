@@ -182,13 +182,15 @@ void CoupledModel::account_energy(double) {
 // sum m |a|^2 with a the constrained accelerations (rotations included).
 std::array<double, 2> CoupledModel::acceleration_norm() const {
   const auto& P = dem_.particles;
-  std::vector<double> con(P.size() * 3, 0.0);
-  for (int p = 0; p < ops_.num_particles(); ++p)
-    for (int c = 0; c < 3; ++c) con[3 * ops_.particles[p] + c] = acc_d_(p, c);
   double sum = 0.0;
-  for (std::size_t i = 0; i < P.size(); ++i) {
-    const Vec3 a = P.force[i] * P.inv_mass[i] - Vec3{con[3 * i], con[3 * i + 1], con[3 * i + 2]};
-    sum += norm2(a) / P.inv_mass[i] + norm2(P.torque[i]) * P.inv_inertia(i);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    sum += norm2(P.force[i]) * P.inv_mass[i] + norm2(P.torque[i]) * P.inv_inertia(i);
+  // Coupled DEs: replace m|f/m|^2 by m|f/m - a_con|^2 (no per-step scratch array).
+  for (int p = 0; p < ops_.num_particles(); ++p) {
+    const std::uint32_t i = ops_.particles[p];
+    const Vec3 a = P.force[i] * P.inv_mass[i];
+    const Vec3 constrained = a - Vec3{acc_d_(p, 0), acc_d_(p, 1), acc_d_(p, 2)};
+    sum += (norm2(constrained) - norm2(a)) / P.inv_mass[i];
   }
   double sum_c = 0.0;
   const auto& f = continuum_.force();
