@@ -1,5 +1,9 @@
 #include "common/png_plot.hpp"
 
+#include <zlib.h>
+
+#include "common/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -470,7 +474,7 @@ Axis make_axis(double dmin, double dmax, bool log, int max_ticks) {
 }
 
 // ---------------------------------------------------------------------------------------
-// PNG encoding: 8-bit RGB, filter 0 on every row, zlib stream of stored deflate blocks.
+// PNG encoding: 8-bit RGB, filter 0 on every row, one zlib stream.
 
 std::uint32_t crc32_update(std::uint32_t crc, const std::uint8_t* data, std::size_t size) {
   static const std::array<std::uint32_t, 256> table = [] {
@@ -510,29 +514,13 @@ std::string encode_png(const Canvas& canvas) {
     raw.append(reinterpret_cast<const char*>(canvas.rgb().data()) + y * row_bytes, row_bytes);
   }
 
-  std::string zlib;
-  constexpr std::size_t max_block = 65535;
-  zlib.reserve(raw.size() + raw.size() / max_block * 5 + 16);
-  zlib.push_back(0x78);  // deflate, 32 KiB window
-  zlib.push_back(0x01);  // no preset dictionary, fastest; (0x78 * 256 + 0x01) % 31 == 0
-  std::size_t pos = 0;
-  do {
-    const std::size_t n = std::min(max_block, raw.size() - pos);
-    const bool last = pos + n == raw.size();
-    zlib.push_back(last ? 1 : 0);  // BFINAL, BTYPE 00 (stored), padded to the byte
-    zlib.push_back(static_cast<char>(n & 0xFF));
-    zlib.push_back(static_cast<char>(n >> 8));
-    zlib.push_back(static_cast<char>(~n & 0xFF));
-    zlib.push_back(static_cast<char>((~n >> 8) & 0xFF));
-    zlib.append(raw, pos, n);
-    pos += n;
-  } while (pos < raw.size());
-  std::uint32_t a = 1, b = 0;  // Adler-32 of the uncompressed data
-  for (const char ch : raw) {
-    a = (a + static_cast<unsigned char>(ch)) % 65521;
-    b = (b + a) % 65521;
-  }
-  put_u32(zlib, (b << 16) | a);
+  // zlib (deflate, default level): plots are mostly flat colour, so they shrink ~50-fold.
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string zlib(size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(zlib.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
+                static_cast<uLong>(raw.size()), Z_DEFAULT_COMPRESSION) != Z_OK)
+    throw arlequin::RunError("PNG encoding: zlib could not compress the image");
+  zlib.resize(size);
 
   std::string header;
   put_u32(header, static_cast<std::uint32_t>(w));

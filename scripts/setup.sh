@@ -3,7 +3,7 @@
 # apt-get install), then configure and build into build/.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-packages=(g++ cmake pkg-config libeigen3-dev petsc-dev libcgal-dev libgmsh-dev gmsh
+packages=(g++ cmake pkg-config zlib1g-dev libeigen3-dev petsc-dev libcgal-dev libgmsh-dev gmsh
           libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev)
 missing=()
 for p in "${packages[@]}"; do
