@@ -14,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/fields_writer.hpp"
 #include "common/json.hpp"
+#include "common/png_plot.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -104,6 +105,28 @@ class Outputs {
     if (fields_) fields_->close();
   }
   const CsvSeries& series() const { return *series_; }
+
+  // The case's plots of series columns (after the last row).
+  void write_plots() const {
+    const auto& columns = series_->columns();
+    const auto column = [&](const std::string& name, double scale) {
+      const std::size_t c = std::find(columns.begin(), columns.end(), name) - columns.begin();
+      std::vector<double> v;
+      for (std::size_t r = 0; r < series_->rows() && c < columns.size(); ++r) v.push_back(scale * series_->row(r)[c]);
+      return v;
+    };
+    for (const PlotPlan& plan : scene_.output.plots) {
+      PlotSpec spec;
+      spec.title = plan.title;
+      spec.x_label = plan.x_label;
+      spec.y_label = plan.y_label;
+      spec.y2_label = plan.y2_label;
+      const auto x = column(plan.x, plan.x_scale);
+      for (const auto& y : plan.y) spec.series.push_back({y, x, column(y, plan.y_scale)});
+      for (const auto& y : plan.y2) spec.series.push_back({y, x, column(y, plan.y2_scale), PlotSeries::Style::line, true});
+      write_png_plot(scene_.output.dir / plan.file, spec);
+    }
+  }
 
  private:
   Vec3 sensor_value(const Sensor& s) const {
@@ -319,6 +342,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     failure = e.what();
   }
   progress.finish();
+  outputs.write_plots();
   result.steps = steps_done;
   result.simulated_time = current_time();
   result.wall_seconds = seconds_since(t_start);

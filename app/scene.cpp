@@ -431,6 +431,24 @@ void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& 
       (f == "particles" ? plan.particle_fields : f == "bonds" ? plan.bond_fields : plan.continuum_fields) = true;
     }
     plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
+    for (CaseNode p : out->list_or_empty("plots")) {
+      PlotPlan plot;
+      plot.file = p.string("file");
+      if (plot.file.extension() != ".png" || plot.file.has_parent_path())
+        p.fail("file", "expected a file name ending in .png (written in the output folder)");
+      plot.title = p.string_or("title", "");
+      plot.x = p.string("x");
+      plot.x_scale = p.number_or("x_scale", 1.0, Range::any(), "1");
+      plot.x_label = p.string_or("x_label", plot.x);
+      plot.y = p.strings("y");
+      plot.y_scale = p.number_or("y_scale", 1.0, Range::any(), "1");
+      plot.y_label = p.string_or("y_label", "");
+      plot.y2 = p.strings_or("y2", {});
+      plot.y2_scale = p.number_or("y2_scale", 1.0, Range::any(), "1");
+      plot.y2_label = p.string_or("y2_label", "");
+      p.finish();
+      plan.plots.push_back(plot);
+    }
     out->finish();
   }
   if (!options.out_dir.empty()) plan.dir = options.out_dir;
@@ -531,6 +549,17 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   std::vector<std::string> columns = sensor_columns(scene);
   columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_fracture", "E_total"});
   read_checks(root, scene, columns);
+  // Plot columns: sensors, energies, time and the broken fractions.
+  columns.insert(columns.end(), {"time", "step", "E_balance", "C_kinetic", "C_strain", "W_coupling"});
+  for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
+  for (const PlotPlan& plot : scene.output.plots) {
+    std::vector<std::string> used{plot.x};
+    used.insert(used.end(), plot.y.begin(), plot.y.end());
+    used.insert(used.end(), plot.y2.begin(), plot.y2.end());
+    for (const auto& c : used)
+      if (std::find(columns.begin(), columns.end(), c) == columns.end())
+        throw InputError(root.where() + ": output.plots: no series column '" + c + "' for " + plot.file.string());
+  }
   root.finish();
   scene.resolved_case = file.resolved_yaml();
   return scene;

@@ -22,7 +22,8 @@
 //   checks:   [{column, statistic: final | max | min | final_over_initial, expected, tolerance, note}
 //              | {column, statistic, at_most, at_least, note}
 //              | {column, crossing: value, expected: time [s], tolerance, note}]
-//   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s]}
+//   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s],
+//              plots: [{file, title, x, x_scale, x_label, y: [..], y_scale, y_label, y2: [..], y2_scale, y2_label}]}
 #pragma once
 #include <cmath>
 #include <filesystem>
@@ -61,6 +62,14 @@ struct Check {
   std::string note;           // where the expected value comes from
 };
 
+// A PNG plot of series.csv columns written at the end of a run (also a stopped one).
+struct PlotPlan {
+  std::filesystem::path file;  // relative to the output folder
+  std::string title, x, x_label, y_label, y2_label;
+  double x_scale = 1.0, y_scale = 1.0, y2_scale = 1.0;  // multiply the columns (e.g. 1/L for strain)
+  std::vector<std::string> y, y2;                       // left and right axes
+};
+
 struct OutputPlan {
   std::filesystem::path dir;
   double every = 0.0;         // s, series.csv rows
@@ -68,6 +77,7 @@ struct OutputPlan {
   bool particle_fields = false;
   bool bond_fields = false;
   bool continuum_fields = false;
+  std::vector<PlotPlan> plots;
 };
 
 struct Scene {

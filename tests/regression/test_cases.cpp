@@ -113,6 +113,7 @@ TEST(Cases, LatticeBarFailsAtTheBondStrength) {
   const std::string breaks = test::read_text(out / "breaks.csv");
   EXPECT_EQ(std::count(breaks.begin(), breaks.end(), '\n'), broken + 1);
   EXPECT_NE(breaks.find(",bonds,bbf,tension,"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out / "failure.png"));  // the case's plot
   EXPECT_GT(s.at("energies").at("fracture").as_number(), 0.0);
   // A break releases its bond's energy within one step: the balance closes to O((omega dt)^2),
   // 0.5 % of the work for this damped run at the case's safety factor 0.1 (1.6 % at 0.3).
