@@ -33,6 +33,9 @@ std::string name(const PatchCase& c) {
          std::to_string(static_cast<int>(c.x2));
 }
 
+// Readable values in test listings (ctest shows them after the test name).
+void PrintTo(const PatchCase& c, std::ostream* os) { *os << name(c); }
+
 OverlapZone slab(double x1, double x2, WeightShape shape) {
   return OverlapZone::box({{x1, -1.0, -1.0}, {x2, 100.0, 100.0}}, 0, true, {shape, 0.05, 0.5});
 }
