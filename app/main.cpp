@@ -11,9 +11,11 @@
 #include <vector>
 
 #include "app/compare.hpp"
+#include "app/calibrate.hpp"
 #include "app/runner.hpp"
 #include "app/scene.hpp"
 #include "app/sweep.hpp"
+#include "app/virtual_tests.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
@@ -30,6 +32,8 @@ constexpr const char* usage_main =
     "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
     "  sweep CASE.yaml   run a case over several values of its keys; table of errors and run times\n"
     "  build-sample CASE.yaml   build the case's packing (dem.sample.build: packing) and save it\n"
+    "  virtual-test SPEC.yaml   quasi-static tension/shear tests of a sample: moduli, Poisson ratios\n"
+    "  calibrate SPEC.yaml      fit beam bonds (E_mu, r_mu) to a material's (E_M, nu_M) on a packing\n"
     "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
@@ -55,6 +59,22 @@ constexpr const char* usage_compare =
     "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
     "  compare_<sensor>.png\n";
 
+constexpr const char* usage_virtual_test =
+    "usage: arlequin virtual-test SPEC.yaml [--out DIR] [--sample NAME ...] [--set k=v ...]\n"
+    "  runs the spec's quasi-static tests (tension, shear) on each of its samples (only the named\n"
+    "  ones with --sample), results in DIR/<sample>/<test>/ (default results/<folder>_<spec>/);\n"
+    "  prints moduli and Poisson ratios with their uncertainty, writes DIR/tests.csv and, for a\n"
+    "  composite spec, DIR/composite.md (engineering constants against closed forms and references).\n"
+    "  --set applies to the sample case. Spec format: app/virtual_tests.hpp\n";
+
+constexpr const char* usage_calibrate =
+    "usage: arlequin calibrate SPEC.yaml [--out DIR] [--set k=v ...]\n"
+    "  fits the beam bonds' (E_mu, r_mu) of a one-material packing to target (E_M, nu_M): tension\n"
+    "  tests over the spec's r_mu grid (nu_M depends on r_mu only), then E_mu by proportionality;\n"
+    "  a verification run per target. Writes curve.csv, curve.png, calibration.md/.json to DIR\n"
+    "  (default results/<folder>_<spec>/); curve points are cached next to the sample file.\n"
+    "  --set applies to the sample case. Spec format: app/calibrate.hpp\n";
+
 constexpr const char* usage_sweep =
     "usage: arlequin sweep CASE.yaml --over key.path=v1,v2,... [--over ...] [--out DIR] [--set k=v ...]\n"
     "  runs every combination of the --over values (results in DIR/<run>/, default\n"
@@ -68,6 +88,7 @@ struct Arguments {
   app::SceneOptions scene;
   long steps = -1;
   std::vector<app::SweepAxis> axes;
+  std::vector<std::string> samples;  // virtual-test --sample
   bool quiet = false;
   bool help = false;
 };
@@ -75,7 +96,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare", "virtual-test", "calibrate"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -83,7 +104,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare, virtual-test, calibrate"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -101,13 +122,15 @@ Arguments parse(int argc, char** argv) {
       a.scene.petsc_options += " " + value("a quoted PETSc option string");
     } else if (arg == "--over" && a.command == "sweep") {
       a.axes.push_back(app::parse_sweep_axis(value("key.path=v1,v2,...")));
-    } else if (arg == "--out" && (a.command == "run" || a.command == "sweep" || a.command == "compare")) {
+    } else if (arg == "--out" && (a.command == "run" || a.command == "sweep" || a.command == "compare" || a.command == "virtual-test" || a.command == "calibrate")) {
       a.scene.out_dir = value("a directory");
     } else if (arg == "--steps" && a.command == "run") {
       const std::string v = value("a number of steps");
       char* end = nullptr;
       a.steps = std::strtol(v.c_str(), &end, 10);
       if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+    } else if (arg == "--sample" && a.command == "virtual-test") {
+      a.samples.push_back(value("a sample name"));
     } else if (arg == "--quiet" && a.command == "run") {
       a.quiet = true;
     } else if (!arg.starts_with("-") && a.case_file.empty()) {
@@ -210,6 +233,31 @@ int compare(const Arguments& a) {
   return ok ? 0 : 3;
 }
 
+// Default results folder of a spec-driven command: results/<spec folder>_<spec name>.
+std::filesystem::path spec_out_dir(const Arguments& a) {
+  if (!a.scene.out_dir.empty()) return a.scene.out_dir;
+  const std::filesystem::path spec(a.case_file);
+  return "results/" + std::filesystem::absolute(spec).parent_path().filename().string() + "_" + spec.stem().string();
+}
+
+int virtual_test(const Arguments& a) {
+  app::SceneOptions base = a.scene;
+  base.out_dir.clear();
+  const std::filesystem::path out = spec_out_dir(a);
+  const int stopped = app::run_virtual_test_suite(a.case_file, base, out, a.samples);
+  std::printf("results: %s\n", std::filesystem::absolute(out).string().c_str());
+  return stopped == 0 ? 0 : 3;
+}
+
+int calibrate(const Arguments& a) {
+  app::SceneOptions base = a.scene;
+  base.out_dir.clear();
+  const std::filesystem::path out = spec_out_dir(a);
+  app::calibrate(app::CalibrationSpec::read(a.case_file), base, out);
+  std::printf("results: %s\n", std::filesystem::absolute(out).string().c_str());
+  return 0;
+}
+
 int check(const Arguments& a) {
   app::Scene scene = app::build_scene(a.case_file, a.scene);
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
@@ -227,6 +275,8 @@ int main(int argc, char** argv) {
       std::fputs(a.command == "run"     ? usage_run
                  : a.command == "check" ? usage_check
                  : a.command == "sweep" ? usage_sweep
+                 : a.command == "virtual-test" ? usage_virtual_test
+                 : a.command == "calibrate" ? usage_calibrate
                  : a.command == "compare" ? usage_compare
                                         : usage_main,
                  stdout);
@@ -235,6 +285,8 @@ int main(int argc, char** argv) {
     if (a.command == "run") return run(a);
     if (a.command == "sweep") return sweep(a);
     if (a.command == "build-sample") return build_sample(a);
+    if (a.command == "virtual-test") return virtual_test(a);
+    if (a.command == "calibrate") return calibrate(a);
     if (a.command == "compare") return compare(a);
     return check(a);
   } catch (const InputError& e) {

@@ -1,0 +1,324 @@
+#include "app/calibrate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "common/atomic_file.hpp"
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+#include "common/json.hpp"
+#include "common/png_plot.hpp"
+
+namespace arlequin::app {
+namespace {
+
+constexpr std::string_view axis_names[] = {"x", "y", "z"};
+
+std::string format(const char* pattern, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, pattern, value);
+  return buffer;
+}
+
+// Mean of n estimates with uncertainty sqrt(sum u_i^2 / n^2 + s^2 / n) (header).
+Estimate pooled(const std::vector<Estimate>& v) {
+  const double n = double(v.size());
+  double mean = 0.0, u2 = 0.0;
+  for (const auto& e : v) mean += e.value / n, u2 += e.uncertainty * e.uncertainty / (n * n);
+  double s2 = 0.0;
+  for (const auto& e : v) s2 += (e.value - mean) * (e.value - mean) / std::max(n - 1.0, 1.0);
+  return {mean, std::sqrt(u2 + s2 / n)};
+}
+
+// Measures the case with the bond's (E_mu, r_mu), pooled over the spec's axes.
+Measurement measure(const CalibrationSpec& spec, const SceneOptions& options, double E_mu, double r_mu,
+                    const std::filesystem::path& dir) {
+  std::vector<Estimate> young, poisson;
+  Measurement m;
+  for (int axis : spec.axes) {
+    SceneOptions o = options;
+    o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", E_mu));
+    o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", r_mu));
+    o.out_dir = dir / axis_names[axis];
+    LoadCase load;
+    load.name = "tension_" + std::string(axis_names[axis]);
+    load.face = load.direction = axis;
+    const VirtualTestResult r = run_virtual_test(spec.case_file, o, load, spec.plan);
+    young.push_back(r.modulus);
+    for (int k = 0; k < 3; ++k)
+      if (k != axis) poisson.push_back(r.poisson[k]);
+    m.wall_seconds += r.wall_seconds;
+    m.particles = r.particles;
+  }
+  m.young = pooled(young);
+  m.poisson = pooled(poisson);
+  return m;
+}
+
+Json estimate_json(const Estimate& e) {
+  Json j = Json::object();
+  j["value"] = e.value;
+  j["uncertainty"] = e.uncertainty;
+  return j;
+}
+Estimate read_estimate(const Json& j) { return {j.at("value").as_number(), j.at("uncertainty").as_number()}; }
+
+// The cache of curve points next to the sample: {"entries": [{"signature", "points": [...]}]}.
+class CurveCache {
+ public:
+  CurveCache(std::filesystem::path file, std::string signature) : file_(std::move(file)), signature_(std::move(signature)) {
+    if (std::filesystem::exists(file_)) {
+      std::ifstream in(file_);
+      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      try {
+        document_ = Json::parse(text);
+      } catch (const InputError&) {
+        std::fprintf(stderr, "calibrate: ignoring an unreadable cache %s\n", file_.string().c_str());
+      }
+    }
+    if (!document_.find("entries")) document_ = Json::object(), document_["entries"] = Json::array();
+  }
+  std::optional<CurvePoint> find(double r_mu) const {
+    for (const Json& p : points())
+      if (p.at("r_mu").as_number() == r_mu)
+        return CurvePoint{r_mu, read_estimate(p.at("young_per_E_mu")), read_estimate(p.at("poisson")), "cache"};
+    return std::nullopt;
+  }
+  void store(const CurvePoint& point) {
+    Json p = Json::object();
+    p["r_mu"] = point.r_mu;
+    p["young_per_E_mu"] = estimate_json(point.young_per_E_mu);
+    p["poisson"] = estimate_json(point.poisson);
+    Json entries = Json::array();
+    bool stored = false;
+    for (const Json& e : document_.at("entries").as_array()) {
+      Json copy = e;
+      if (e.at("signature").as_string() == signature_) copy["points"].push_back(p), stored = true;
+      entries.push_back(copy);
+    }
+    if (!stored) {
+      Json e = Json::object();
+      e["signature"] = signature_;
+      e["points"].push_back(p);
+      entries.push_back(e);
+    }
+    document_["entries"] = entries;
+    write_json_atomically(file_, document_);
+  }
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  const Json::Array& points() const {
+    static const Json::Array none;
+    for (const Json& e : document_.at("entries").as_array())
+      if (e.at("signature").as_string() == signature_) return e.at("points").as_array();
+    return none;
+  }
+  std::filesystem::path file_;
+  std::string signature_;
+  Json document_;
+};
+
+// Linear interpolation of the curve at the r_mu where nu_M = target (the first crossing).
+std::optional<double> crossing(const std::vector<CurvePoint>& curve, double target) {
+  for (std::size_t i = 0; i + 1 < curve.size(); ++i) {
+    const double a = curve[i].poisson.value - target, b = curve[i + 1].poisson.value - target;
+    if (a == 0.0) return curve[i].r_mu;
+    if ((a < 0.0) != (b < 0.0)) return curve[i].r_mu + (curve[i + 1].r_mu - curve[i].r_mu) * a / (a - b);
+  }
+  if (!curve.empty() && curve.back().poisson.value == target) return curve.back().r_mu;
+  return std::nullopt;
+}
+
+void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result, const std::filesystem::path& out_dir) {
+  std::string csv = "r_mu,E_M_per_E_mu,E_M_per_E_mu_u,nu_M,nu_M_u,source\n";
+  PlotSeries nu{"nu_M", {}, {}, PlotSeries::Style::line_points}, young{"E_M / E_mu", {}, {}, PlotSeries::Style::line_points, true};
+  for (const auto& p : result.curve) {
+    csv += format("%.9g", p.r_mu) + "," + format("%.9g", p.young_per_E_mu.value) + "," + format("%.3g", p.young_per_E_mu.uncertainty) +
+           "," + format("%.9g", p.poisson.value) + "," + format("%.3g", p.poisson.uncertainty) + "," + p.source + "\n";
+    nu.x.push_back(p.r_mu), nu.y.push_back(p.poisson.value);
+    young.x.push_back(p.r_mu), young.y.push_back(p.young_per_E_mu.value);
+  }
+  write_file_atomically(out_dir / "curve.csv", csv);
+  PlotSeries chosen{"calibrated (r_mu, nu_M)", {}, {}, PlotSeries::Style::points};
+  for (const auto& pair : result.pairs) chosen.x.push_back(pair.r_mu), chosen.y.push_back(pair.achieved.front().poisson.value);
+  write_png_plot(out_dir / "curve.png", PlotSpec{"Calibration curve: tension tests at E_mu = 1 Pa", "r_mu", "nu_M", "E_M / E_mu",
+                                                 {nu, young, chosen}});
+
+  std::string md =
+      "| material | target E_M GPa | target nu_M | E_mu GPa | r_mu | sample | DEs | achieved E_M GPa | E_M error | achieved nu_M | "
+      "nu_M error | reference E_mu GPa | reference r_mu |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  Json pairs = Json::array();
+  for (const auto& p : result.pairs) {
+    const auto& t = p.target;
+    Json j = Json::object();
+    j["name"] = t.name;
+    j["target_E_M"] = t.young;
+    j["target_nu_M"] = t.poisson;
+    j["E_mu"] = p.E_mu;
+    j["r_mu"] = p.r_mu;
+    if (t.reference_E_mu) j["reference_E_mu"] = *t.reference_E_mu;
+    if (t.reference_r_mu) j["reference_r_mu"] = *t.reference_r_mu;
+    Json& achieved = j["achieved"];
+    for (const Measurement& m : p.achieved) {
+      md += "| " + t.name + " | " + format("%.4g", t.young * 1e-9) + " | " + format("%.3f", t.poisson) + " | " +
+            format("%.5g", p.E_mu * 1e-9) + " | " + format("%.4f", p.r_mu) + " | " + m.sample + " | " + std::to_string(m.particles) +
+            " | " + format("%.4g", m.young.value * 1e-9) + format(" ± %.2g", m.young.uncertainty * 1e-9) + " | " +
+            format("%+.2f %%", 100.0 * (m.young.value / t.young - 1.0)) + " | " + format("%.4f", m.poisson.value) +
+            format(" ± %.2g", m.poisson.uncertainty) + " | " + format("%+.4f", m.poisson.value - t.poisson) + " | " +
+            (t.reference_E_mu ? format("%.5g", *t.reference_E_mu * 1e-9) : std::string("-")) + " | " +
+            (t.reference_r_mu ? format("%.4g", *t.reference_r_mu) : std::string("-")) + " |\n";
+      Json a = Json::object();
+      a["sample"] = m.sample;
+      a["particles"] = m.particles;
+      a["E_M"] = estimate_json(m.young);
+      a["nu_M"] = estimate_json(m.poisson);
+      a["wall_seconds"] = m.wall_seconds;
+      achieved.push_back(a);
+    }
+    pairs.push_back(j);
+  }
+  write_file_atomically(out_dir / "calibration.md", md);
+  Json summary = Json::object();
+  summary["case_file"] = std::filesystem::absolute(spec.case_file).string();
+  summary["plan"] = spec.plan.describe();
+  summary["pairs"] = pairs;
+  write_json_atomically(out_dir / "calibration.json", summary);
+  std::printf("\n%s\ncurve: %s\n", md.c_str(), std::filesystem::absolute(out_dir / "curve.png").string().c_str());
+}
+
+}  // namespace
+
+CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
+  CaseFile file = CaseFile::load(spec_file);
+  CaseNode root = file.root();
+  CalibrationSpec spec;
+  spec.case_file = root.existing_file("case");
+  spec.bond_key = root.string_or("bond", spec.bond_key);
+  spec.radius_ratios = root.numbers("r_mu", Range::positive(), "1");
+  std::sort(spec.radius_ratios.begin(), spec.radius_ratios.end());
+  if (spec.radius_ratios.size() < 2) root.fail("r_mu", "expected at least two values to interpolate between");
+  if (root.has("axes")) {
+    spec.axes.clear();
+    for (const std::string& a : root.strings("axes")) {
+      const auto it = std::find(std::begin(axis_names), std::end(axis_names), a);
+      if (it == std::end(axis_names)) root.fail("axes", "expected a list of x, y, z, got '" + a + "'");
+      spec.axes.push_back(int(it - std::begin(axis_names)));
+    }
+    if (spec.axes.empty()) root.fail("axes", "expected at least one axis");
+  }
+  spec.tolerance = root.number_or("tolerance", spec.tolerance, Range::positive(), "1");
+  for (CaseNode v : root.list_or_empty("verify")) {
+    spec.verify.push_back({v.string("name"), v.strings("set")});
+    v.finish();
+  }
+  spec.plan = QuasiStatic::read(root.child_if("quasi_static"));
+  for (CaseNode t : root.list("targets")) {
+    CalibrationTarget target{t.string("name"), t.number("E", Range::positive(), "Pa"), t.number("nu", Range::open_between(-1.0, 0.5), "1"),
+                             std::nullopt, std::nullopt};
+    if (auto ref = t.child_if("reference")) {
+      target.reference_E_mu = ref->number("E_mu", Range::positive(), "Pa");
+      target.reference_r_mu = ref->number("r_mu", Range::positive(), "1");
+      ref->finish();
+    }
+    t.finish();
+    spec.targets.push_back(target);
+  }
+  root.finish();
+  return spec;
+}
+
+CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir) {
+  // The cache key: the case as resolved with fixed placeholder bond values, and the test plan.
+  SceneOptions probe_options = options;
+  probe_options.overrides.push_back(spec.bond_key + ".E_mu=1");
+  probe_options.overrides.push_back(spec.bond_key + ".r_mu=1");
+  const Scene probe = build_scene(spec.case_file, probe_options);
+  std::string signature = probe.resolved_case + "\n# plan: " + spec.plan.describe() + "\n# axes:";
+  for (int a : spec.axes) signature.append(" ").append(axis_names[a]);
+  CurveCache cache((probe.sample ? probe.sample_file.parent_path() : out_dir) / "calibration_cache.json", signature);
+  std::printf("calibration of %s (%s); cache %s\n", spec.case_file.string().c_str(), spec.plan.describe().c_str(),
+              cache.file().string().c_str());
+
+  CalibrationResult result;
+  const auto point_at = [&](double r_mu, const char* source) {
+    for (const auto& p : result.curve)
+      if (p.r_mu == r_mu) return p;
+    CurvePoint p;
+    if (auto cached = cache.find(r_mu)) {
+      p = *cached;
+    } else {
+      const Measurement m = measure(spec, options, 1.0, r_mu, out_dir / "curve" / ("r_" + format("%.6g", r_mu)));
+      p = {r_mu, m.young, m.poisson, source};
+      cache.store(p);
+    }
+    std::printf("  r_mu %.6g: E_M / E_mu = %.6g ± %.2g, nu_M = %.4f ± %.2g (%s)\n", r_mu, p.young_per_E_mu.value,
+                p.young_per_E_mu.uncertainty, p.poisson.value, p.poisson.uncertainty, p.source.c_str());
+    std::fflush(stdout);
+    result.curve.push_back(p);
+    std::sort(result.curve.begin(), result.curve.end(), [](const CurvePoint& a, const CurvePoint& b) { return a.r_mu < b.r_mu; });
+    return p;
+  };
+  for (double r : spec.radius_ratios) point_at(r, "grid");
+
+  std::vector<Measurement> per_unit;  // verification runs with E_M per unit E_mu
+  for (const CalibrationTarget& target : spec.targets) {
+    if (!crossing(result.curve, target.poisson)) {
+      throw InputError("calibrate: target nu_M = " + format("%.4g", target.poisson) + " of '" + target.name +
+                       "' is outside the curve's range (nu_M from " + format("%.4g", result.curve.front().poisson.value) +
+                       " to " + format("%.4g", result.curve.back().poisson.value) + "); widen r_mu");
+    }
+    // Refine: measure at the interpolated r_mu until a point's nu_M is within the tolerance.
+    const auto closest = [&] {
+      return *std::min_element(result.curve.begin(), result.curve.end(), [&](const CurvePoint& a, const CurvePoint& b) {
+        return std::abs(a.poisson.value - target.poisson) < std::abs(b.poisson.value - target.poisson);
+      });
+    };
+    CurvePoint at = closest();
+    for (int round = 0; round < 4 && std::abs(at.poisson.value - target.poisson) > spec.tolerance; ++round) {
+      point_at(*crossing(result.curve, target.poisson), "refinement");
+      at = closest();
+    }
+    CalibratedPair pair;
+    pair.target = target;
+    pair.r_mu = at.r_mu;
+    pair.E_mu = target.young / at.young_per_E_mu.value;
+    std::vector<CalibrationSpec::Variant> samples{{"calibration", {}}};
+    samples.insert(samples.end(), spec.verify.begin(), spec.verify.end());
+    for (const auto& sample : samples) {
+      // Every pair is run on the calibration sample, which checks E_M proportional to E_mu;
+      // on the other samples a pair with an r_mu measured before reuses that run, scaled.
+      const auto known = std::find_if(per_unit.begin(), per_unit.end(), [&](const Measurement& u) {
+        return u.sample == sample.name && u.r_mu == pair.r_mu;
+      });
+      Measurement m;
+      if (sample.name != "calibration" && known != per_unit.end()) {
+        m = *known;
+        m.young = {known->young.value * pair.E_mu, known->young.uncertainty * pair.E_mu};
+        m.wall_seconds = 0.0;
+      } else {
+        SceneOptions o = options;
+        o.overrides.insert(o.overrides.end(), sample.overrides.begin(), sample.overrides.end());
+        m = measure(spec, o, pair.E_mu, pair.r_mu, out_dir / target.name / sample.name);
+        m.sample = sample.name;
+        m.r_mu = pair.r_mu;
+        Measurement unit = m;
+        unit.young = {m.young.value / pair.E_mu, m.young.uncertainty / pair.E_mu};
+        per_unit.push_back(unit);
+      }
+      std::printf("%s: E_mu = %.6g GPa, r_mu = %.5f on %s (%zu DEs): E_M = %.5g ± %.2g GPa (target %.5g), nu_M = %.4f ± %.2g "
+                  "(target %.4f)\n",
+                  target.name.c_str(), pair.E_mu * 1e-9, pair.r_mu, m.sample.c_str(), m.particles, m.young.value * 1e-9,
+                  m.young.uncertainty * 1e-9, target.young * 1e-9, m.poisson.value, m.poisson.uncertainty, target.poisson);
+      std::fflush(stdout);
+      pair.achieved.push_back(m);
+    }
+    result.pairs.push_back(pair);
+  }
+  write_outputs(spec, result, out_dir);
+  return result;
+}
+
+}  // namespace arlequin::app

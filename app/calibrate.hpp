@@ -1,0 +1,102 @@
+// Calibration of beam-bond micro parameters (E_mu, r_mu) against macroscopic elastic targets
+// (E_M, nu_M) with quasi-static virtual tensile tests (DESIGN.md section 3; seed Table 1,
+// REFERENCE.md R2; Andre, Iordanoff, Charles, Neauport, CMAME 213-216 (2012) 113, section 4):
+// on a given packing, nu_M depends (almost) only on r_mu, and at fixed r_mu the bond forces,
+// hence E_M, are proportional to E_mu. So:
+//  1. the calibration curve: tension tests (virtual_tests.hpp) at E_mu = 1 Pa over a grid of
+//     r_mu, giving E_M / E_mu and nu_M per r_mu (averaged over the chosen tension axes);
+//  2. per target: r_mu where the curve's nu_M (linear between neighbouring points) equals the
+//     target, refined by measuring there and interpolating again until |nu_M - target| <=
+//     tolerance (at most 4 rounds); E_mu = E_target / (E_M / E_mu) at that r_mu;
+//  3. verification runs of the pair at the material's own E_mu: the achieved E_M and nu_M, on
+//     the calibration sample (E_M there matches by construction, a check of the proportionality)
+//     and on the spec's other samples (another seed, another size: the packing's own effect);
+//     there, a pair whose r_mu an earlier pair had reuses that run, E_M scaled by E_mu.
+// The curve is measured with the case's own nu_mu (targets share it). Curve points are cached
+// next to the sample file (calibration_cache.json), keyed by the case as resolved and the test
+// plan, so a second calibration on the same packing only runs what is new.
+//
+// Averages over n axes: the mean, uncertainty sqrt(sum u_i^2 / n^2 + s^2 / n), s the spread
+// (standard deviation) between the axes; nu_M pools both lateral ratios of every axis.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/scene.hpp"
+#include "app/virtual_tests.hpp"
+
+namespace arlequin::app {
+
+struct CalibrationTarget {
+  std::string name;
+  double young = 0.0;    // E_M, Pa
+  double poisson = 0.0;  // nu_M
+  std::optional<double> reference_E_mu, reference_r_mu;  // a published pair (seed Table 1), for the report
+};
+
+// Spec file (strict YAML; `arlequin calibrate SPEC.yaml`):
+//   case: sample.yaml        one-material case: a packing, density, a beam bond law with nu_mu
+//   bond: dem.bond           key path of the bond section whose E_mu and r_mu are calibrated
+//   r_mu: [0.15, 0.2, ...]   the grid of the curve
+//   axes: [x, y, z]          tension axes averaged per point (default [z])
+//   tolerance: 0.002         on nu_M for the refinement
+//   verify: [{name, set: ["key=value", ...]}]   further samples to verify the pairs on; give
+//                            each its own sample file (name= or dem.sample.file=), else its
+//                            packing replaces the calibration sample's cached one
+//   quasi_static: {...}      QuasiStatic (virtual_tests.hpp)
+//   targets: [{name, E [Pa], nu, reference: {E_mu [Pa], r_mu}}]
+struct CalibrationSpec {
+  std::filesystem::path case_file;
+  std::string bond_key = "dem.bond";
+  std::vector<double> radius_ratios;
+  std::vector<int> axes{2};
+  double tolerance = 0.002;
+  struct Variant {
+    std::string name;
+    std::vector<std::string> overrides;
+  };
+  std::vector<Variant> verify;
+  QuasiStatic plan;
+  std::vector<CalibrationTarget> targets;
+
+  static CalibrationSpec read(const std::filesystem::path& spec_file);  // InputError at the key
+};
+
+struct CurvePoint {
+  double r_mu = 0.0;
+  Estimate young_per_E_mu;  // E_M / E_mu
+  Estimate poisson;         // nu_M
+  std::string source;       // "grid", "refinement" or "cache"
+};
+
+// E_M and nu_M of a case pooled over the spec's tension axes.
+struct Measurement {
+  std::string sample;  // "calibration", or the name of a verify variant
+  double r_mu = 0.0;
+  Estimate young;      // E_M, Pa
+  Estimate poisson;
+  std::size_t particles = 0;
+  double wall_seconds = 0.0;
+};
+
+struct CalibratedPair {
+  CalibrationTarget target;
+  double E_mu = 0.0;  // Pa
+  double r_mu = 0.0;
+  std::vector<Measurement> achieved;  // the calibration sample first, then the verify variants
+};
+
+struct CalibrationResult {
+  std::vector<CurvePoint> curve;  // sorted by r_mu
+  std::vector<CalibratedPair> pairs;
+};
+
+// Runs the calibration into out_dir (runs in out_dir/curve/r_<r_mu>/<axis>/ and
+// out_dir/<target>/<sample>/<axis>/), writes curve.csv, curve.png, calibration.md and calibration.json
+// there, and prints the curve and the pairs. options' overrides apply to the case. InputError
+// if a target's nu_M is outside the curve's range (widen r_mu); RunError if a run stops.
+CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir);
+
+}  // namespace arlequin::app

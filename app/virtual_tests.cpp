@@ -1,0 +1,589 @@
+#include "app/virtual_tests.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "app/micromechanics.hpp"
+#include "app/runner.hpp"
+#include "common/atomic_file.hpp"
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+#include "common/json.hpp"
+
+namespace arlequin::app {
+namespace {
+
+constexpr std::string_view axis_names[] = {"x", "y", "z"};
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+int axis_index(CaseNode& node, std::string_view key, const std::string& text) {
+  for (int k = 0; k < 3; ++k)
+    if (text == axis_names[k]) return k;
+  node.fail(key, "expected an axis x, y or z, got '" + text + "'");
+}
+
+std::string format(const char* pattern, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, pattern, value);
+  return buffer;
+}
+std::string number_text(double value) { return format("%.17g", value); }
+// The shortest text that reads back as the same double.
+std::string shortest(double value) {
+  char buffer[32];
+  return std::string(buffer, std::to_chars(buffer, buffer + sizeof buffer, value).ptr);
+}
+
+// The columns of a series.csv written by the runner.
+struct SeriesTable {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+
+  static SeriesTable read(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    if (!in) throw RunError("cannot read " + path.string());
+    SeriesTable t;
+    std::string line, cell;
+    std::getline(in, line);
+    for (std::stringstream header(line); std::getline(header, cell, ',');) t.columns.push_back(cell);
+    while (std::getline(in, line)) {
+      std::vector<double>& row = t.rows.emplace_back();
+      for (std::stringstream values(line); std::getline(values, cell, ',');) row.push_back(std::strtod(cell.c_str(), nullptr));
+      if (row.size() != t.columns.size()) throw RunError(path.string() + ": a row has the wrong number of values");
+    }
+    return t;
+  }
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(columns.begin(), columns.end(), name);
+    if (it == columns.end()) throw RunError("series.csv has no column '" + name + "'");
+    return std::size_t(it - columns.begin());
+  }
+};
+
+// Average over the window with uncertainty sqrt(sd^2 + drift^2) (header).
+Estimate window_average(const std::vector<double>& v) {
+  const auto mean = [](auto begin, auto end) {
+    double s = 0.0;
+    for (auto it = begin; it != end; ++it) s += *it;
+    return s / double(end - begin);
+  };
+  const std::size_t n = v.size(), half = n / 2;
+  const double m = mean(v.begin(), v.end());
+  double var = 0.0;
+  for (double x : v) var += (x - m) * (x - m);
+  const double sd = std::sqrt(var / double(n - 1));
+  const double drift = mean(v.begin() + half, v.end()) - mean(v.begin(), v.begin() + half);
+  return {m, std::hypot(sd, drift)};
+}
+
+// a / b with relative uncertainties added in quadrature.
+Estimate ratio(const Estimate& a, const Estimate& b) {
+  const double r = a.value / b.value;
+  return {r, std::abs(r) * std::hypot(a.uncertainty / a.value, b.uncertainty / b.value)};
+}
+
+// The sample as the tests see it: the DEs' bounding box, their mean radius and mean density.
+struct SampleGeometry {
+  Vec3 lower, upper;
+  double mean_radius = 0.0;
+  double density = 0.0;  // kg/m^3, DE mass / box volume
+
+  explicit SampleGeometry(const dem::ParticleSet& p) {
+    if (p.size() == 0) throw InputError("a virtual test needs a DEM sample (dem section)");
+    lower = upper = p.position[0];
+    double mass = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        lower[k] = std::min(lower[k], p.position[i][k] - p.radius[i]);
+        upper[k] = std::max(upper[k], p.position[i][k] + p.radius[i]);
+      }
+      mean_radius += p.radius[i];
+      mass += p.mass(i);
+    }
+    mean_radius /= double(p.size());
+    density = mass / volume();
+  }
+  double length(int k) const { return upper[k] - lower[k]; }
+  double volume() const { return length(0) * length(1) * length(2); }
+  double area(int normal) const { return volume() / length(normal); }
+};
+
+// Affine modulus (header): bond energy under the test's homogeneous strain on every centre.
+double affine_modulus(const dem::DemModel& model, const SampleGeometry& g, const LoadCase& load) {
+  constexpr double strain = 1e-6;
+  dem::ParticleSet p = model.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) p.position[i][load.direction] += strain * (p.position[i][load.face] - g.lower[load.face]);
+  double energy = 0.0;
+  for (const auto& set : model.bond_sets()) energy += set->energy(p);
+  return 2.0 * energy / (strain * strain * g.volume());
+}
+
+std::string group_name(int axis, bool upper) { return "face_" + std::string(axis_names[axis]) + (upper ? "max" : "min"); }
+std::string displacement_column(int axis, bool upper) { return "u_" + group_name(axis, upper).substr(5); }
+
+// The slab of DE centres within one mean diameter of a face, as a case-file region.
+std::string slab_yaml(const SampleGeometry& g, int axis, bool upper) {
+  const double t = 2.0 * g.mean_radius;
+  std::string lo = "[", hi = "[";
+  for (int k = 0; k < 3; ++k) {
+    double a = g.lower[k] - g.length(k), b = g.upper[k] + g.length(k);  // across the sample, with margin
+    if (k == axis && upper) a = g.upper[k] - t;
+    if (k == axis && !upper) b = g.lower[k] + t;
+    lo += (k ? ", " : "") + number_text(a);
+    hi += (k ? ", " : "") + number_text(b);
+  }
+  return "{name: " + group_name(axis, upper) + ", region: {box: [" + lo + "], " + hi + "]]}}";
+}
+
+// The axes whose faces get slabs: the loaded one, and for tension the two lateral ones.
+std::vector<int> slab_axes(const LoadCase& load) {
+  if (load.shear()) return {load.face};
+  std::vector<int> axes{load.face};
+  for (int k = 0; k < 3; ++k)
+    if (k != load.face) axes.push_back(k);
+  return axes;
+}
+
+// The generated sections of one test (header), as --set overrides.
+std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase& load, const QuasiStatic& plan,
+                                        double transit, double damping) {
+  const std::string axis(axis_names[load.face]), dir(axis_names[load.direction]);
+  std::string groups, sensors;
+  for (int k : slab_axes(load)) {
+    for (bool upper : {false, true}) {
+      groups += (groups.empty() ? "" : ", ") + slab_yaml(g, k, upper);
+      const int component = k == load.face ? load.direction : k;
+      sensors += (sensors.empty() ? "" : ", ") + std::string("{name: ") + displacement_column(k, upper) +
+                 ", type: displacement, group: " + group_name(k, upper) + ", component: " + std::string(axis_names[component]) + "}";
+    }
+  }
+  for (bool upper : {false, true})
+    sensors += std::string(", {name: ") + (upper ? "F_moved" : "F_held") + ", type: force, group: " +
+               group_name(load.face, upper) + ", component: " + dir + "}";
+  Vec3 motion{};
+  motion[load.direction] = plan.strain * g.length(load.face);
+  const std::string value = "[" + number_text(motion.x) + ", " + number_text(motion.y) + ", " + number_text(motion.z) + "]";
+  const std::string ramp = number_text(plan.ramp * transit);
+  const std::string boundary =
+      load.shear() ? "[{group: " + group_name(load.face, false) + ", type: fixed}, {group: " + group_name(load.face, true) +
+                         ", type: displacement, value: " + value + ", ramp: " + ramp + ", rotation: fixed}]"
+                   : "[{group: " + group_name(load.face, false) + ", type: velocity, value: [0, 0, 0], components: [" + axis +
+                         "]}, {group: " + group_name(load.face, true) + ", type: displacement, value: " + value +
+                         ", ramp: " + ramp + ", components: [" + axis + "]}]";
+  return {"groups=[" + groups + "]",
+          "boundary=" + boundary,
+          "sensors=[" + sensors + "]",
+          "checks=[]",
+          "time.end=" + number_text((plan.ramp + plan.plateau) * transit),
+          "output.every=" + number_text(transit / plan.rows_per_transit),
+          "dem.damping=" + number_text(damping)};
+}
+
+// Mean reference coordinate along `axis` of the DEs of a face slab.
+double centroid(const dem::DemModel& model, int axis, bool upper) {
+  const auto ids = model.members(model.group_index(group_name(axis, upper)));
+  double s = 0.0;
+  for (auto i : ids) s += model.particles.reference[i][axis];
+  return s / double(ids.size());
+}
+
+Json estimate_json(const Estimate& e) {
+  Json j = Json::object();
+  j["value"] = e.value;
+  j["uncertainty"] = e.uncertainty;
+  return j;
+}
+
+// ---- Suites ------------------------------------------------------------------------------
+
+struct SampleVariant {
+  std::string name;
+  std::vector<std::string> overrides;
+};
+
+// The engineering constants of a unidirectional composite, in table order.
+constexpr const char* constant_keys[] = {"E_L", "E_T", "nu_LT", "nu_TT", "G_LT", "G_TT"};
+using Constants = std::array<double, 6>;
+bool is_poisson(std::size_t c) { return c == 2 || c == 3; }
+
+// A unidirectional composite (REFERENCE.md R3): its phases, the closed forms and reference rows.
+struct CompositeSpec {
+  IsotropicPhase fibre{}, matrix{};
+  double fraction = 0.0;
+  std::vector<std::pair<std::string, Constants>> references;  // NaN: not given
+
+  static IsotropicPhase read_phase(CaseNode node) {
+    IsotropicPhase phase{node.number("E", Range::positive(), "Pa"), node.number("nu", Range::open_between(-1.0, 0.5), "1")};
+    node.finish();
+    return phase;
+  }
+  static CompositeSpec read(CaseNode node) {
+    CompositeSpec c;
+    c.fibre = read_phase(node.child("fibre"));
+    c.matrix = read_phase(node.child("matrix"));
+    c.fraction = node.number("fibre_fraction", Range::between(0.0, 1.0), "1");
+    for (CaseNode row : node.list_or_empty("references")) {
+      Constants values;
+      for (std::size_t k = 0; k < values.size(); ++k)
+        values[k] = row.has(constant_keys[k]) ? row.number(constant_keys[k], Range::any(), is_poisson(k) ? "1" : "Pa") : nan;
+      c.references.emplace_back(row.string("name"), values);
+      row.finish();
+    }
+    node.finish();
+    return c;
+  }
+  Constants theory() const {
+    const UnidirectionalModuli m = unidirectional_moduli(fibre, matrix, fraction);
+    return {m.E_L, m.E_T, m.nu_LT, m.nu_TT, m.G_LT, m.G_TT};
+  }
+};
+
+// The four tests of a composite suite, checked against their roles (run_virtual_test_suite).
+struct CompositeTests {
+  std::size_t L, T, LT, TT;  // indices into the suite's tests
+  int transverse_prime;      // the axis that is neither L's nor T's
+
+  static CompositeTests find(CaseNode& node, const std::vector<LoadCase>& tests) {
+    const auto index = [&](const char* name) {
+      for (std::size_t i = 0; i < tests.size(); ++i)
+        if (tests[i].name == name) return i;
+      node.fail("composite", std::string("a composite suite needs a test named ") + name);
+    };
+    CompositeTests c{index("L"), index("T"), index("LT"), index("TT"), 0};
+    const LoadCase &l = tests[c.L], &t = tests[c.T], &lt = tests[c.LT], &tt = tests[c.TT];
+    if (l.shear() || t.shear() || l.face == t.face) node.fail("composite", "L and T must be tensions along two different axes");
+    c.transverse_prime = 3 - l.face - t.face;
+    const auto spans = [](const LoadCase& s, int a, int b) {
+      return s.shear() && ((s.face == a && s.direction == b) || (s.face == b && s.direction == a));
+    };
+    if (!spans(lt, l.face, t.face)) node.fail("composite", "LT must be a shear in the plane of L's and T's axes");
+    if (!spans(tt, t.face, c.transverse_prime)) node.fail("composite", "TT must be a shear in the plane of T's axis and the third one");
+    return c;
+  }
+  // E_L, E_T, nu_LT (mean over both transverse axes), nu_TT', G_LT, G_TT'.
+  std::array<Estimate, 6> constants(const std::vector<VirtualTestResult>& r) const {
+    const auto& lateral = r[L].poisson;
+    const int a = (r[L].load.face + 1) % 3, b = (r[L].load.face + 2) % 3;
+    const double mean = 0.5 * (lateral[a].value + lateral[b].value);
+    const Estimate nu_lt{mean, std::hypot(0.5 * std::hypot(lateral[a].uncertainty, lateral[b].uncertainty),
+                                          0.5 * (lateral[a].value - lateral[b].value))};
+    return {r[L].modulus, r[T].modulus, nu_lt, r[T].poisson[transverse_prime], r[LT].modulus, r[TT].modulus};
+  }
+  // The closed form's modulus behind test i's time scale, if it is one of the four. L takes
+  // E_T too: its lateral (Poisson) contraction moves at transverse wave speeds, far slower
+  // than its axial waves.
+  std::optional<double> estimate(std::size_t i, const Constants& theory) const {
+    if (i == L || i == T) return theory[1];
+    if (i == LT) return theory[4];
+    if (i == TT) return theory[5];
+    return std::nullopt;
+  }
+};
+
+// Constant c's value for tables: moduli in GPa, Poisson ratios plain; uncertainties to 2 digits.
+std::string table_value(std::size_t c, double v, bool uncertainty = false) {
+  if (std::isnan(v)) return "-";
+  if (uncertainty) return is_poisson(c) ? format("%.1g", v) : format("%.2g", v * 1e-9);
+  return is_poisson(c) ? format("%.3f", v) : format("%.4g", v * 1e-9);
+}
+
+std::string composite_tables(const CompositeSpec& spec, const std::vector<std::string>& samples,
+                             const std::vector<std::array<Estimate, 6>>& measured, const std::vector<std::size_t>& particles,
+                             const std::vector<std::array<double, 4>>& walls) {
+  std::string md = "| source | DEs | E_L GPa | E_T GPa | nu_LT | nu_TT' | G_LT GPa | G_TT' GPa |\n|---|---|---|---|---|---|---|---|\n";
+  std::vector<std::pair<std::string, Constants>> rows{{"theory (ROM; Hashin K23; Halpin-Tsai)", spec.theory()}};
+  rows.insert(rows.end(), spec.references.begin(), spec.references.end());
+  for (const auto& [name, values] : rows) {
+    md += "| " + name + " | |";
+    for (std::size_t c = 0; c < 6; ++c) md.append(" ").append(table_value(c, values[c])).append(" |");
+    md += "\n";
+  }
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    md += "| DEM " + samples[s] + " | " + std::to_string(particles[s]) + " |";
+    for (std::size_t c = 0; c < 6; ++c)
+      md.append(" ").append(table_value(c, measured[s][c].value)).append(" ± ").append(table_value(c, measured[s][c].uncertainty, true)).append(" |");
+    md += "\n";
+  }
+  md += "\nDifferences of the DEM rows: moduli relative, (DEM - reference) / reference; Poisson ratios absolute, DEM - reference.\n\n"
+        "| sample | against | E_L | E_T | nu_LT | nu_TT' | G_LT | G_TT' |\n|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    for (const auto& [name, values] : rows) {
+      md += "| " + samples[s] + " | " + name + " |";
+      for (std::size_t c = 0; c < 6; ++c) {
+        const double v = measured[s][c].value;
+        md += std::isnan(values[c]) ? std::string(" - |")
+              : is_poisson(c)       ? format(" %+.3f |", v - values[c])
+                                    : format(" %+.1f %% |", 100.0 * (v - values[c]) / values[c]);
+      }
+      md += "\n";
+    }
+  }
+  md += "\nWall time per test, s (scene build + run):\n\n| sample | DEs | L | T | LT | TT' | total |\n|---|---|---|---|---|---|---|\n";
+  for (std::size_t s = 0; s < samples.size(); ++s) {
+    const auto& w = walls[s];
+    md += "| " + samples[s] + " | " + std::to_string(particles[s]) + " |";
+    for (double x : w) md += format(" %.0f |", x);
+    md += format(" %.0f |\n", w[0] + w[1] + w[2] + w[3]);
+  }
+  return md;
+}
+
+std::string csv_header() {
+  return "sample,test,load,particles,bonds,steps,dt,transit_time,modulus_estimate,damping,stress,stress_u,strain,strain_u,"
+         "modulus,modulus_u,poisson_x,poisson_x_u,poisson_y,poisson_y_u,poisson_z,poisson_z_u,force_imbalance,"
+         "kinetic_to_bond,wall_seconds,status\n";
+}
+
+std::string csv_row(const std::string& sample, const VirtualTestResult& r, const std::string& status) {
+  std::string row = sample + "," + r.load.name + "," + r.load.describe() + "," + std::to_string(r.particles) + "," +
+                    std::to_string(r.bonds) + "," + std::to_string(r.steps);
+  for (double v : {r.dt, r.transit_time, r.modulus_used, r.damping, r.stress.value, r.stress.uncertainty, r.strain.value,
+                   r.strain.uncertainty, r.modulus.value, r.modulus.uncertainty, r.poisson[0].value, r.poisson[0].uncertainty,
+                   r.poisson[1].value, r.poisson[1].uncertainty, r.poisson[2].value, r.poisson[2].uncertainty,
+                   r.force_imbalance, r.kinetic_to_bond, r.wall_seconds})
+    row.append(",").append(format("%.9g", v));
+  return row + "," + status + "\n";
+}
+
+}  // namespace
+
+std::string LoadCase::describe() const {
+  return shear() ? "shear of the " + std::string(axis_names[face]) + " faces along " + std::string(axis_names[direction])
+                 : "tension along " + std::string(axis_names[face]);
+}
+
+LoadCase LoadCase::read(CaseNode& node) {
+  LoadCase load;
+  load.name = node.string("name");
+  if (load.name.empty() || load.name.find_first_of("/\\ ,") != std::string::npos)
+    node.fail("name", "expected a non-empty name without spaces, commas or slashes");
+  if (node.has("tension") == node.has("shear")) node.fail("tension", "give exactly one of tension: axis or shear: [face, direction]");
+  if (node.has("tension")) {
+    load.face = load.direction = axis_index(node, "tension", node.string("tension"));
+  } else {
+    const auto axes = node.strings("shear");
+    if (axes.size() != 2) node.fail("shear", "expected [face normal, direction], e.g. [z, x]");
+    load.face = axis_index(node, "shear", axes[0]);
+    load.direction = axis_index(node, "shear", axes[1]);
+    if (load.face == load.direction) node.fail("shear", "the direction must differ from the face normal (that is tension)");
+  }
+  if (node.has("modulus_estimate")) load.modulus_estimate = node.number("modulus_estimate", Range::positive(), "Pa");
+  return load;
+}
+
+QuasiStatic QuasiStatic::read(std::optional<CaseNode> node) {
+  QuasiStatic q;
+  if (!node) return q;
+  q.strain = node->number_or("strain", q.strain, Range::open_between(0.0, 0.05), "1");
+  q.ramp = node->number_or("ramp", q.ramp, Range::positive(), "transit times");
+  q.plateau = node->number_or("plateau", q.plateau, Range::positive(), "transit times");
+  q.damping = node->number_or("damping", q.damping, Range::non_negative(), "1");
+  q.average = node->number_or("average", q.average, Range::open_between(0.0, 1.0), "1");
+  q.rows_per_transit = node->number_or("rows_per_transit", q.rows_per_transit, Range::at_least(2.0), "1");
+  node->finish();
+  return q;
+}
+
+std::string QuasiStatic::describe() const {
+  return "strain " + shortest(strain) + ", ramp " + shortest(ramp) + " T, plateau " + shortest(plateau) + " T, damping " +
+         shortest(damping) + " of critical, average over the last " + shortest(average) + " of the plateau, " +
+         shortest(rows_per_transit) + " rows per T";
+}
+
+VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const SceneOptions& options,
+                                   const LoadCase& load, const QuasiStatic& plan) {
+  if (options.out_dir.empty()) throw InputError("run_virtual_test: no output folder given");
+  const auto t0 = std::chrono::steady_clock::now();
+  VirtualTestResult r;
+  r.load = load;
+  r.out_dir = options.out_dir;
+  // A probe of the plain case gives the sample's extent and the affine modulus.
+  const Scene probe = build_scene(case_file, options);
+  const SampleGeometry g(probe.dem.particles);
+  r.affine_estimate = !load.modulus_estimate;
+  r.modulus_used = load.modulus_estimate ? *load.modulus_estimate : affine_modulus(probe.dem, g, load);
+  if (!(r.modulus_used > 0.0)) throw InputError(case_file.string() + ": the sample has no bond stiffness to test");
+  r.transit_time = g.length(load.face) / std::sqrt(r.modulus_used / g.density);
+  r.damping = plan.damping * 2.0 * std::numbers::pi / r.transit_time;
+
+  SceneOptions test_options = options;
+  for (auto& o : test_overrides(g, load, plan, r.transit_time, r.damping)) test_options.overrides.push_back(std::move(o));
+  Scene scene = build_scene(case_file, test_options);
+  const RunResult run = run_scene(scene, RunOptions{});
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.particles = scene.dem.particles.size();
+  for (const auto& set : scene.dem.bond_sets()) r.bonds += set->size();
+  r.steps = run.steps;
+  r.dt = scene.dt;
+  r.kinetic_to_bond = run.energies.kinetic / run.energies.bond;
+
+  // Plateau window: the last `average` of the hold.
+  const SeriesTable series = SeriesTable::read(scene.output.dir / "series.csv");
+  const double window_start = scene.end_time - plan.average * plan.plateau * r.transit_time;
+  std::vector<const std::vector<double>*> window;
+  for (const auto& row : series.rows)
+    if (row[0] >= window_start * (1.0 - 1e-12)) window.push_back(&row);
+  if (window.size() < 4)
+    throw RunError(scene.output.dir.string() + ": fewer than 4 output rows in the averaging window; raise rows_per_transit");
+  const auto column = [&](const std::string& name) {
+    const std::size_t c = series.column(name);
+    std::vector<double> v;
+    for (const auto* row : window) v.push_back((*row)[c]);
+    return v;
+  };
+  // Strain between the slabs of axis k (their sensors record the loaded component).
+  Json gauges = Json::object();
+  const auto strain_between = [&](int k) {
+    const double gauge = centroid(scene.dem, k, true) - centroid(scene.dem, k, false);
+    gauges[std::string(axis_names[k])] = gauge;
+    const auto upper = column(displacement_column(k, true)), lower = column(displacement_column(k, false));
+    std::vector<double> e(upper.size());
+    for (std::size_t i = 0; i < e.size(); ++i) e[i] = (upper[i] - lower[i]) / gauge;
+    return window_average(e);
+  };
+  std::vector<double> stress = column("F_moved"), imbalance(stress.size());
+  const auto held = column("F_held");
+  for (std::size_t i = 0; i < stress.size(); ++i) {
+    imbalance[i] = std::abs(stress[i] + held[i]) / std::abs(stress[i]);
+    stress[i] /= g.area(load.face);
+  }
+  r.stress = window_average(stress);
+  r.force_imbalance = window_average(imbalance).value;
+  r.strain = strain_between(load.face);
+  r.modulus = ratio(r.stress, r.strain);
+  if (!load.shear()) {
+    for (int k : slab_axes(load)) {
+      if (k == load.face) continue;
+      r.lateral_strain[k] = strain_between(k);
+      const Estimate nu = ratio(r.lateral_strain[k], r.strain);
+      r.poisson[k] = {-nu.value, nu.uncertainty};
+    }
+  }
+
+  Json j = Json::object();
+  j["case_file"] = std::filesystem::absolute(case_file).string();
+  j["test"] = load.name;
+  j["load"] = load.describe();
+  j["plan"] = plan.describe();
+  j["transit_time"] = r.transit_time;
+  j["modulus_estimate"] = r.modulus_used;
+  j["modulus_estimate_source"] = r.affine_estimate ? "affine (bond energy under homogeneous strain)" : "given";
+  j["damping"] = r.damping;
+  j["stress"] = estimate_json(r.stress);
+  j["strain"] = estimate_json(r.strain);
+  j["modulus"] = estimate_json(r.modulus);
+  for (int k = 0; k < 3; ++k)
+    if (!std::isnan(r.poisson[k].value)) j["poisson_" + std::string(axis_names[k])] = estimate_json(r.poisson[k]);
+  j["gauge_lengths"] = gauges;
+  j["force_imbalance"] = r.force_imbalance;
+  j["kinetic_to_bond_energy"] = r.kinetic_to_bond;
+  j["particles"] = r.particles;
+  j["bonds"] = r.bonds;
+  j["steps"] = r.steps;
+  j["dt"] = r.dt;
+  j["wall_seconds"] = r.wall_seconds;
+  write_json_atomically(scene.output.dir / "test.json", j);
+  return r;
+}
+
+namespace {
+
+// One line per test for the console.
+std::string describe_result(const VirtualTestResult& r) {
+  std::string line = r.load.shear() ? "G" : "E";
+  line += format(" = %.5g", r.modulus.value * 1e-9) + format(" ± %.2g GPa", r.modulus.uncertainty * 1e-9);
+  for (int k = 0; k < 3; ++k)
+    if (!std::isnan(r.poisson[k].value))
+      line += ", nu_" + std::string(axis_names[r.load.face]) + std::string(axis_names[k]) + format(" %.4f", r.poisson[k].value) +
+              format(" ± %.2g", r.poisson[k].uncertainty);
+  line += format(", imbalance %.1e", r.force_imbalance) + ", " + std::to_string(r.particles) + " DEs, " +
+          std::to_string(r.steps) + " steps" + format(", wall %.1f s", r.wall_seconds);
+  return line;
+}
+
+}  // namespace
+
+int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
+                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples) {
+  CaseFile file = CaseFile::load(spec_file);
+  CaseNode root = file.root();
+  const std::filesystem::path case_file = root.existing_file("case");
+  std::vector<SampleVariant> samples;
+  for (CaseNode s : root.list_or_empty("samples")) {
+    samples.push_back({s.string("name"), s.strings_or("set", {})});
+    s.finish();
+  }
+  if (samples.empty()) samples.push_back({"base", {}});
+  for (const auto& name : only_samples)
+    if (std::none_of(samples.begin(), samples.end(), [&](const SampleVariant& s) { return s.name == name; }))
+      throw InputError(spec_file.string() + ": no sample named '" + name + "'");
+  const QuasiStatic plan = QuasiStatic::read(root.child_if("quasi_static"));
+  std::vector<LoadCase> tests;
+  for (CaseNode t : root.list("tests")) {
+    tests.push_back(LoadCase::read(t));
+    t.finish();
+  }
+  std::optional<CompositeSpec> composite;
+  std::optional<CompositeTests> roles;
+  if (auto node = root.child_if("composite")) {
+    composite = CompositeSpec::read(*node);
+    roles = CompositeTests::find(root, tests);
+    const Constants theory = composite->theory();
+    for (std::size_t i = 0; i < tests.size(); ++i)
+      if (!tests[i].modulus_estimate) tests[i].modulus_estimate = roles->estimate(i, theory);
+  }
+  root.finish();
+
+  std::printf("virtual tests of %s: %s\n", case_file.string().c_str(), plan.describe().c_str());
+  std::string csv = csv_header();
+  std::vector<std::string> names;
+  std::vector<std::array<Estimate, 6>> constants;
+  std::vector<std::size_t> particles;
+  std::vector<std::array<double, 4>> walls;
+  int stopped = 0;
+  for (const SampleVariant& sample : samples) {
+    if (!only_samples.empty() && std::find(only_samples.begin(), only_samples.end(), sample.name) == only_samples.end()) continue;
+    std::vector<VirtualTestResult> results;
+    for (const LoadCase& load : tests) {
+      SceneOptions test_options = options;
+      test_options.overrides.insert(test_options.overrides.end(), sample.overrides.begin(), sample.overrides.end());
+      test_options.out_dir = out_dir / sample.name / load.name;
+      try {
+        results.push_back(run_virtual_test(case_file, test_options, load, plan));
+        std::printf("%s %s (%s): %s\n", sample.name.c_str(), load.name.c_str(), load.describe().c_str(),
+                    describe_result(results.back()).c_str());
+        csv += csv_row(sample.name, results.back(), "ok");
+      } catch (const RunError& e) {
+        ++stopped;
+        std::printf("%s %s: stopped: %s\n", sample.name.c_str(), load.name.c_str(), e.what());
+        VirtualTestResult failed;
+        failed.load = load;
+        results.push_back(failed);
+        csv += csv_row(sample.name, failed, "stopped");
+      }
+      std::fflush(stdout);
+      write_file_atomically(out_dir / "tests.csv", csv);
+    }
+    if (roles) {
+      names.push_back(sample.name);
+      constants.push_back(roles->constants(results));
+      particles.push_back(results[roles->L].particles);
+      walls.push_back({results[roles->L].wall_seconds, results[roles->T].wall_seconds, results[roles->LT].wall_seconds,
+                       results[roles->TT].wall_seconds});
+    }
+  }
+  if (composite) {
+    const std::string md = composite_tables(*composite, names, constants, particles, walls);
+    write_file_atomically(out_dir / "composite.md", md);
+    std::printf("\n%s", md.c_str());
+  }
+  return stopped;
+}
+
+}  // namespace arlequin::app

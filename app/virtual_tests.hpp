@@ -1,0 +1,136 @@
+// Quasi-static virtual material tests on a DEM sample: tension and simple shear of a box-shaped
+// sample, the seed's "first challenge" (homogenised moduli of a REV, seed Fig. 3 and Table 3;
+// REFERENCE.md R2, R3), and the suites of them that `arlequin virtual-test` runs.
+//
+// A test is the sample case (dem sample, materials or bond law; no groups, boundary or sensors
+// of its own) plus generated sections (`--set` overrides):
+//  - groups: one slab per loaded or gauged face, one mean DE diameter thick, from the DEs'
+//    bounding box (the DEs whose centre lies in it);
+//  - tension along axis a: the lower a-face held in component a only, the upper a-face moved
+//    by a linear ramp to strain * L_a in component a only (rollers: lateral contraction free);
+//    the four lateral faces free, with displacement sensors for the Poisson ratios;
+//  - shear of the faces normal to n along d: the lower n-face fixed (all components and
+//    rotations), the upper one moved by strain * L_n along d with its other components and
+//    rotations held (a guided clamp); the lateral faces free. The result is the apparent
+//    shear modulus of the block, bending of the block included;
+//  - force sensors (component along the motion) on both loaded faces, displacement sensors
+//    on every slab; time: the ramp, then a plateau with the load held; global viscous damping.
+// Measures (seed: "sliding average ... excluding the ramp"): every series is averaged over
+// the last `average` fraction of the plateau. Stress = force on the moved face / face area
+// (the box's cross-section); strain_kk = (mean displacement of the upper k-slab - of the lower
+// one) / distance between the slabs' centroids, which is the boundary average of the
+// strain (divergence theorem) over the slabs' centre planes; shear angle likewise.
+// Uncertainty of an average: sqrt(sd^2 + drift^2) with sd the standard deviation over the
+// window (oscillation left) and drift the difference between the means of its two halves
+// (creep towards equilibrium not finished): a bound, not a standard error. Moduli and Poisson
+// ratios propagate relative uncertainties in quadrature.
+//
+// Time scale: a wave transit time T = L / sqrt(M / rho), L the sample length along the loaded
+// faces' normal, rho the sample's mean density (DE mass / box volume), M the test's modulus
+// estimate: given (e.g. a closed-form estimate), or else the affine one, the energy of the
+// bonds under the test's homogeneous strain applied to every DE centre (M = 2 W / (strain^2 V):
+// the P-wave modulus for tension, the shear modulus for shear; an upper bound, Voigt, so T is
+// rather short). Ramp and plateau are in units of T; the damping c = zeta * 2 pi / T (1/s),
+// zeta the fraction of critical damping of the fundamental mode (omega_1 = pi / T, both faces
+// held); mass-proportional damping lets every mode decay as exp(-c t / 2).
+#pragma once
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "app/scene.hpp"
+
+namespace arlequin {
+class CaseNode;
+}
+
+namespace arlequin::app {
+
+// A time average with its uncertainty (see above).
+struct Estimate {
+  double value = std::numeric_limits<double>::quiet_NaN();
+  double uncertainty = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Which faces are loaded and how. Axes are 0, 1, 2 for x, y, z.
+struct LoadCase {
+  std::string name;
+  int face = 2;       // the loaded faces are normal to this axis
+  int direction = 2;  // the upper face moves along this axis
+  std::optional<double> modulus_estimate;  // Pa, for the time scale; none: affine estimate
+
+  bool shear() const { return face != direction; }
+  std::string describe() const;  // "tension along z", "shear of the z faces along x"
+  // Reads {name, tension: z} or {name, shear: [z, x]} (faces, then direction) and an optional
+  // modulus_estimate [Pa]; InputError at the key otherwise.
+  static LoadCase read(CaseNode& node);
+};
+
+// How slowly and how long; ramp and plateau in wave transit times (see above).
+struct QuasiStatic {
+  double strain = 2.0e-4;  // final normal strain (tension) or shear angle (shear)
+  double ramp = 3.0;
+  double plateau = 3.0;
+  double damping = 0.5;    // zeta, fraction of critical damping of the fundamental mode; 0: none
+  double average = 0.5;    // the last fraction of the plateau that is averaged
+  double rows_per_transit = 20.0;
+
+  // Reads an optional mapping {strain, ramp, plateau, damping, average, rows_per_transit}.
+  static QuasiStatic read(std::optional<CaseNode> node);
+  std::string describe() const;  // one line, for reports and cache keys (every field, exactly)
+};
+
+struct VirtualTestResult {
+  LoadCase load;
+  Estimate stress;    // Pa: sigma_aa on the moved face (tension), tau_nd (shear)
+  Estimate strain;    // measured between the loaded slabs: eps_aa, or the shear angle gamma_nd
+  Estimate modulus;   // stress / strain: E_a, or the apparent G_nd
+  std::array<Estimate, 3> lateral_strain;  // tension: eps_kk of the free axes k; NaN otherwise
+  std::array<Estimate, 3> poisson;         // tension: nu_ak = -eps_kk / eps_aa; NaN otherwise
+  double force_imbalance = 0.0;  // |F_moved + F_held| / |F_moved| averaged: distance from equilibrium
+  double kinetic_to_bond = 0.0;  // E_kinetic / E_bond at the end
+  double transit_time = 0.0;     // s
+  double modulus_used = 0.0;     // Pa, the estimate behind transit_time
+  bool affine_estimate = false;  // modulus_used is the affine estimate
+  double damping = 0.0;          // 1/s
+  std::size_t particles = 0, bonds = 0;
+  long steps = 0;
+  double dt = 0.0;               // s
+  double wall_seconds = 0.0;     // scene build + run
+  std::filesystem::path out_dir;
+};
+
+// Runs one test of the sample case into options.out_dir (required) and measures it; options'
+// overrides apply to the case before the test's own. Writes test.json next to the run's
+// outputs. InputError if the case is not a DEM case or the load case is bad; RunError if the
+// run stops or leaves no plateau rows.
+VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const SceneOptions& options,
+                                   const LoadCase& load, const QuasiStatic& plan);
+
+// `arlequin virtual-test SPEC.yaml`: a suite of tests on one or more samples. Spec (strict):
+//   case: case.yaml                  the sample case (relative to the spec file)
+//   samples: [{name, set: ["key=value", ...]}]   variants of the case (default: one, "base")
+//   quasi_static: {...}              QuasiStatic
+//   tests: [{name, tension: z | shear: [z, x], modulus_estimate}]
+//   composite:                       optional: a unidirectional composite whose tests are named
+//     fibre: {E, nu}, matrix: {E, nu}, fibre_fraction     L (tension along the fibres), T
+//     references: [{name, E_L, E_T, nu_LT, nu_TT, G_LT, G_TT}]  (tension across), LT (shear
+//                                    in the L-T plane), TT (shear in the T-T' plane, for
+//                                    G_TT'); its engineering constants are tabulated next to the
+//                                    closed forms (app/micromechanics.hpp) and the references,
+//                                    whose missing entries are left blank; tests without a
+//                                    modulus_estimate take the closed form's (E_T for L and T,
+//                                    G_LT, G_TT': the slowest motion of each test).
+// Runs every sample (or only those named in only_samples) x test into out_dir/<sample>/<test>/,
+// prints one line per test and the tables, and writes out_dir/tests.csv and (with composite)
+// out_dir/composite.md. options' overrides apply to the case before the sample's. Returns the
+// number of runs that stopped (0: all measured).
+int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
+                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples = {});
+
+}  // namespace arlequin::app

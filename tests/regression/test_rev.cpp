@@ -1,0 +1,238 @@
+// Virtual material tests, the calibration of beam bonds and the composite REV
+// (app/virtual_tests.hpp, app/calibrate.hpp, cases/rev_elastic; REFERENCE.md R2, R3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "app/virtual_tests.hpp"
+#include "common/case_file.hpp"
+#include "common/json.hpp"
+#include "support/cli.hpp"
+
+namespace arlequin {
+namespace {
+
+const std::filesystem::path rev_case = std::filesystem::path(ARLEQUIN_SOURCE_DIR) / "cases" / "rev_elastic";
+
+void write(const std::filesystem::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+// A homogeneous packing of ~2.4k DEs (1.6 mm cube, mean radius 60 um), cached in `dir`.
+std::filesystem::path homogeneous_case(const std::filesystem::path& dir) {
+  write(dir / "sample.yaml",
+        "name: homogeneous\n"
+        "time: {end: 1.0e-6}\n"
+        "dem:\n"
+        "  sample: {build: packing, region: {box: [[0, 0, 0], [1.6e-3, 1.6e-3, 1.6e-3]]}, radius: {mean: 6.0e-5, std: 0.25},\n"
+        "           seed: 3, file: sample.h5}\n"
+        "  density: 1200\n"
+        "  bond: {law: beam, E_mu: 1.0e11, nu_mu: 0.3, r_mu: 0.3}\n");
+  return dir / "sample.yaml";
+}
+
+app::LoadCase load_case(const char* name, int face, int direction) {
+  app::LoadCase load;
+  load.name = name;
+  load.face = face;
+  load.direction = direction;
+  return load;
+}
+
+// Rows of a CSV file as maps column -> text.
+std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path) {
+  std::istringstream in(test::read_text(path));
+  std::string line, cell;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::stringstream s(line); std::getline(s, cell, ',');) header.push_back(cell);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    auto& row = rows.emplace_back();
+    std::size_t k = 0;
+    for (std::stringstream s(line); std::getline(s, cell, ',') && k < header.size();) row[header[k++]] = cell;
+  }
+  return rows;
+}
+double number(const std::map<std::string, std::string>& row, const std::string& column) { return std::stod(row.at(column)); }
+
+// The engineering constants of a composite suite from its tests.csv rows of one sample.
+struct RevConstants {
+  double E_L, E_T, nu_LT, nu_TT, G_LT, G_TT;
+};
+RevConstants rev_constants(const std::filesystem::path& tests_csv) {
+  std::map<std::string, std::map<std::string, std::string>> by_test;
+  for (const auto& row : read_csv(tests_csv)) {
+    EXPECT_EQ(row.at("status"), "ok") << row.at("test");
+    by_test[row.at("test")] = row;
+  }
+  const auto& L = by_test.at("L");
+  const auto& T = by_test.at("T");
+  return {number(L, "modulus"),
+          number(T, "modulus"),
+          0.5 * (number(L, "poisson_x") + number(L, "poisson_y")),
+          number(T, "poisson_y"),
+          number(by_test.at("LT"), "modulus"),
+          number(by_test.at("TT"), "modulus")};
+}
+
+// Tension along two axes and simple shear of a homogeneous packing: the moduli of an isotropic
+// solid, measured quasi-statically, and E_M proportional to E_mu (the calibration's premise).
+TEST(VirtualTests, HomogeneousPackingIsIsotropicAndScalesWithEmu) {
+  const auto dir = test::scratch_dir("virtual_tests_homogeneous");
+  const auto case_file = homogeneous_case(dir);
+  app::SceneOptions options;
+  app::QuasiStatic plan;
+  plan.ramp = plan.plateau = 4.0;  // the affine estimate of the shear modulus is well above the clamped cube's
+  const auto run = [&](const app::LoadCase& load, const std::string& tag, double E_mu) {
+    options.out_dir = dir / tag;
+    options.overrides = {"dem.bond.E_mu=" + std::to_string(E_mu)};
+    return app::run_virtual_test(case_file, options, load, plan);
+  };
+  const app::VirtualTestResult z = run(load_case("z", 2, 2), "z", 1e11);
+  const app::VirtualTestResult x = run(load_case("x", 0, 0), "x", 1e11);
+  const app::VirtualTestResult z2 = run(load_case("z", 2, 2), "z2", 2e11);
+  const app::VirtualTestResult shear = run(load_case("s", 2, 0), "s", 1e11);
+  for (const auto* r : {&z, &x, &shear}) {
+    EXPECT_LT(r->modulus.uncertainty, 0.02 * r->modulus.value) << r->load.name;
+    EXPECT_LT(r->force_imbalance, 0.02) << r->load.name;  // quasi-static: both faces carry the same force
+    EXPECT_TRUE(std::filesystem::exists(r->out_dir / "test.json"));
+  }
+  EXPECT_NEAR(x.modulus.value / z.modulus.value, 1.0, 0.1);  // isotropic packing, to its ~2.4k DEs' scatter
+  for (int k : {0, 1}) EXPECT_NEAR(z.poisson[k].value, 0.3, 0.05) << k;  // r_mu = 0.3: nu_M near 0.3
+  EXPECT_TRUE(std::isnan(z.poisson[2].value));
+  // Stiffness proportional to E_mu, the time scale following it: the same run, rescaled.
+  EXPECT_NEAR(z2.modulus.value / z.modulus.value, 2.0, 1e-6);
+  EXPECT_NEAR(z2.poisson[0].value, z.poisson[0].value, 1e-6);
+  // Simple shear of a clamped cube: the apparent modulus is below E / (2 (1 + nu)), bending included.
+  const double G = z.modulus.value / (2.0 * (1.0 + z.poisson[0].value));
+  EXPECT_LT(shear.modulus.value, G);
+  EXPECT_GT(shear.modulus.value, 0.5 * G);
+}
+
+// A coarse calibration through the command line: the pair hits the target on its packing, the
+// curve is written and plotted, and a second calibration reuses the cached curve points.
+TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
+  const auto dir = test::scratch_dir("calibration_coarse");
+  homogeneous_case(dir);
+  write(dir / "calibration.yaml",
+        "case: sample.yaml\n"
+        "r_mu: [0.2, 0.3, 0.4]\n"
+        "tolerance: 0.005\n"
+        "targets: [{name: epoxy, E: 3.45e9, nu: 0.3, reference: {E_mu: 89.0e9, r_mu: 0.33}}]\n");
+  const auto first = test::run_arlequin("calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "a").string(), "stdout");
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  for (const char* f : {"curve.csv", "curve.png", "calibration.md", "calibration.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir / "a" / f)) << f;
+  EXPECT_TRUE(std::filesystem::exists(dir / "calibration_cache.json"));  // next to the sample
+  const Json pair = Json::parse(test::read_text(dir / "a" / "calibration.json")).at("pairs").as_array().at(0);
+  const Json& achieved = pair.at("achieved").as_array().at(0);
+  EXPECT_NEAR(achieved.at("E_M").at("value").as_number(), 3.45e9, 0.05 * 3.45e9);
+  EXPECT_NEAR(achieved.at("nu_M").at("value").as_number(), 0.3, 0.02);
+  const double r_mu = pair.at("r_mu").as_number();
+  EXPECT_GT(r_mu, 0.2);
+  EXPECT_LT(r_mu, 0.4);
+  EXPECT_GE(read_csv(dir / "a" / "curve.csv").size(), 3u);
+
+  const auto second = test::run_arlequin("calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "b").string(), "stdout");
+  ASSERT_EQ(second.exit_code, 0) << second.output;
+  EXPECT_EQ(second.output.find("(grid)"), std::string::npos) << second.output;
+  EXPECT_EQ(second.output.find("(refinement)"), std::string::npos) << second.output;
+  const Json again = Json::parse(test::read_text(dir / "b" / "calibration.json")).at("pairs").as_array().at(0);
+  EXPECT_EQ(again.at("r_mu").as_number(), r_mu);
+}
+
+TEST(VirtualTests, CompositeSpecNeedsItsFourTests) {
+  const auto dir = test::scratch_dir("virtual_tests_bad_spec");
+  homogeneous_case(dir);
+  write(dir / "spec.yaml",
+        "case: sample.yaml\n"
+        "tests: [{name: L, tension: z}, {name: T, tension: x}, {name: LT, shear: [x, z]}]\n"
+        "composite: {fibre: {E: 260.0e9, nu: 0.3}, matrix: {E: 3.45e9, nu: 0.3}, fibre_fraction: 0.513}\n");
+  const auto r = test::run_arlequin("virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("a composite suite needs a test named TT"), std::string::npos) << r.output;
+}
+
+// The REV of cases/rev_elastic reduced to ~2.4k DEs (mean radius 75 um: the matrix between the
+// fibre and a face is about one DE thick), all four tests through the command line. Looser
+// bounds than R3's (which need >= 40k DEs): E_L within 15 % of the rule of mixtures, nu_LT
+// 0.29 +- 0.04, E_T, G_LT, G_TT' within -20 % / +75 % of the seed's FEM row (coarse samples are
+// stiffer across the fibre: +26 %, +50 %, +33 % at this size, +11 %, +15 %, +16 % at 40k DEs),
+// nu_TT' in [0.2, 0.45].
+TEST(RevElastic, ReducedRevGivesTheCompositeConstants) {
+  const auto dir = test::scratch_dir("rev_reduced");
+  write(dir / "spec.yaml",
+        "case: " + (rev_case / "case.yaml").string() + "\n"
+        "samples: [{name: reduced, set: [\"dem.sample.radius.mean=7.5e-5\", \"dem.sample.file=" + (dir / "sample.h5").string() + "\"]}]\n"
+        "tests: [{name: L, tension: z}, {name: T, tension: x}, {name: LT, shear: [x, z]}, {name: TT, shear: [y, x]}]\n"
+        "composite:\n"
+        "  fibre: {E: 260.0e9, nu: 0.3}\n"
+        "  matrix: {E: 3.45e9, nu: 0.3}\n"
+        "  fibre_fraction: 0.513\n"
+        "  references: [{name: seed FEM, E_L: 134.0e9, E_T: 10.7e9, G_LT: 2.32e9, G_TT: 2.21e9}]\n");
+  const auto r = test::run_arlequin("virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string table = test::read_text(dir / "out" / "composite.md");
+  EXPECT_NE(table.find("| theory (ROM; Hashin K23; Halpin-Tsai) | | 135.1 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| seed FEM | | 134 | 10.7 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| DEM reduced |"), std::string::npos) << table;
+  const RevConstants c = rev_constants(dir / "out" / "tests.csv");
+  EXPECT_NEAR(c.E_L, 135.06e9, 0.15 * 135.06e9);
+  EXPECT_NEAR(c.nu_LT, 0.29, 0.04);
+  EXPECT_GT(c.nu_TT, 0.2);
+  EXPECT_LT(c.nu_TT, 0.45);
+  for (auto [value, fem] : {std::pair{c.E_T, 10.7e9}, {c.G_LT, 2.32e9}, {c.G_TT, 2.21e9}}) {
+    EXPECT_GT(value, 0.8 * fem);
+    EXPECT_LT(value, 1.75 * fem);
+  }
+  for (const auto& row : read_csv(dir / "out" / "tests.csv")) EXPECT_LT(number(row, "force_imbalance"), 0.02) << row.at("test");
+}
+
+// R2: the calibration of cases/rev_elastic (curve points are cached next to its sample, so a
+// second run only verifies): both Table 1 materials within 5 % on E_M and 0.02 on nu_M, on the
+// calibration packing and on another seed; case.yaml carries the calibrated pairs.
+TEST(ValidationRev, CalibrationReproducesTable1Materials) {
+  const auto dir = test::scratch_dir("rev_calibration");
+  std::string spec = test::read_text(rev_case / "calibration.yaml");
+  spec = spec.substr(0, spec.find("verify:"));  // the 40k and 80k verifications are README figures
+  spec.replace(spec.find("case: homogeneous.yaml"), 22, "case: " + (rev_case / "homogeneous.yaml").string());
+  write(dir / "calibration.yaml",
+        spec + "verify: [{name: seed_8, set: [\"name=rev_homogeneous_10k_seed8\", \"dem.sample.seed=8\"]}]\n");
+  const auto r = test::run_arlequin("calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "out").string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json pairs = Json::parse(test::read_text(dir / "out" / "calibration.json")).at("pairs");
+  ASSERT_EQ(pairs.as_array().size(), 2u);
+  CaseFile rev = CaseFile::load(rev_case / "case.yaml");
+  CaseNode materials = rev.root().child("dem").child("materials");
+  for (const Json& pair : pairs.as_array()) {
+    for (const Json& a : pair.at("achieved").as_array()) {
+      const double E = pair.at("target_E_M").as_number();
+      EXPECT_NEAR(a.at("E_M").at("value").as_number(), E, 0.05 * E) << pair.at("name").as_string() << " " << a.at("sample").as_string();
+      EXPECT_NEAR(a.at("nu_M").at("value").as_number(), 0.3, 0.02) << pair.at("name").as_string() << " " << a.at("sample").as_string();
+    }
+    CaseNode bond = materials.child_named(pair.at("name").as_string() == "carbon_fibre" ? "fibre" : "matrix").child("bond");
+    EXPECT_NEAR(bond.number("E_mu", Range::positive(), "Pa"), pair.at("E_mu").as_number(), 0.01 * pair.at("E_mu").as_number());
+    EXPECT_NEAR(bond.number("r_mu", Range::positive(), "1"), pair.at("r_mu").as_number(), 0.001);
+  }
+}
+
+// R3 on the 40k-DE REV: E_L within -5 % / +15 % of 135.06 GPa, nu_LT 0.29 +- 0.02, E_T, G_LT and
+// G_TT' within 20 % of the seed's FEM row (10.7 / 2.32 / 2.21 GPa).
+TEST(ValidationRev, Rev40kMatchesSeedTable3) {
+  const auto dir = test::scratch_dir("rev_40k");
+  const auto r = test::run_arlequin("virtual-test " + (rev_case / "virtual_tests.yaml").string() + " --sample rev_40k --out " +
+                                        dir.string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const RevConstants c = rev_constants(dir / "tests.csv");
+  EXPECT_GE(c.E_L, 0.95 * 135.06e9);
+  EXPECT_LE(c.E_L, 1.15 * 135.06e9);
+  EXPECT_NEAR(c.nu_LT, 0.29, 0.02);
+  EXPECT_NEAR(c.E_T, 10.7e9, 0.2 * 10.7e9);
+  EXPECT_NEAR(c.G_LT, 2.32e9, 0.2 * 2.32e9);
+  EXPECT_NEAR(c.G_TT, 2.21e9, 0.2 * 2.21e9);
+}
+
+}  // namespace
+}  // namespace arlequin
