@@ -132,7 +132,50 @@ std::optional<double> crossing(const std::vector<CurvePoint>& curve, double targ
   return std::nullopt;
 }
 
-void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result, const std::filesystem::path& out_dir) {
+// The strengths' rounds as CSV and their table (markdown), in calibration.json's "strengths".
+void write_strengths(const CalibrationResult& result, const std::filesystem::path& out_dir, std::string& md, Json& summary) {
+  std::string csv = "material,criterion,round,threshold,E_mu,r_mu,failure_stress,failure_strain,target_stress,error,broken_at_peak,"
+                    "broken_at_end,particles,wall_seconds\n";
+  md += "\n| material | criterion | target sigma_M GPa | sigma_f_mu GPa | achieved sigma_M GPa | error | eps_M at failure | rounds | "
+        "reference sigma_f_mu GPa | E_mu GPa | r_mu | DEs |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  Json strengths = Json::array();
+  for (const CalibratedStrength& s : result.strengths) {
+    const auto& t = s.target;
+    for (std::size_t n = 0; n < s.rounds.size(); ++n) {
+      const FailureTestResult& r = s.rounds[n].test;
+      csv += t.name + "," + t.criterion + "," + std::to_string(n) + format(",%.9g", s.rounds[n].threshold) + format(",%.9g", s.E_mu) +
+             format(",%.9g", s.r_mu) + format(",%.9g", r.peak_stress) + format(",%.6g", r.strain_at_peak) + format(",%.9g", t.stress) +
+             format(",%.4g", r.peak_stress / t.stress - 1.0) + format(",%.4g", r.broken_at_peak.empty() ? 0.0 : r.broken_at_peak[0].second) +
+             format(",%.4g", r.broken_at_end.empty() ? 0.0 : r.broken_at_end[0].second) + "," + std::to_string(r.particles) +
+             format(",%.1f", r.wall_seconds) + "\n";
+    }
+    const auto& last = s.rounds.back();
+    md += "| " + t.name + " | " + t.criterion + " | " + format("%.4g", t.stress * 1e-9) + " | " + format("%.5g", last.threshold * 1e-9) +
+          " | " + format("%.4g", last.test.peak_stress * 1e-9) + " | " + format("%+.2f %%", 100.0 * (last.test.peak_stress / t.stress - 1.0)) +
+          " | " + format("%.4g", last.test.strain_at_peak) + " | " + std::to_string(s.rounds.size()) + (s.converged ? "" : " (not converged)") +
+          " | " + (t.reference ? format("%.4g", *t.reference * 1e-9) : std::string("-")) + " | " + format("%.5g", s.E_mu * 1e-9) + " | " +
+          format("%.4f", s.r_mu) + " | " + std::to_string(last.test.particles) + " |\n";
+    Json j = Json::object();
+    j["name"] = t.name;
+    j["criterion"] = t.criterion;
+    j["target_stress"] = t.stress;
+    j["threshold"] = last.threshold;
+    j["failure_stress"] = last.test.peak_stress;
+    j["failure_strain"] = last.test.strain_at_peak;
+    j["converged"] = s.converged;
+    j["rounds"] = s.rounds.size();
+    j["E_mu"] = s.E_mu;
+    j["r_mu"] = s.r_mu;
+    if (t.reference) j["reference_threshold"] = *t.reference;
+    strengths.push_back(j);
+  }
+  write_file_atomically(out_dir / "strength.csv", csv);
+  summary["strengths"] = strengths;
+}
+
+// The curve (CSV, PNG) and the pairs' table, in calibration.json's "pairs".
+void write_elastic(const CalibrationSpec& spec, const CalibrationResult& result, const std::filesystem::path& out_dir, std::string& md,
+                   Json& summary) {
   std::string csv = "r_mu,E_M_per_E_mu,E_M_per_E_mu_u,nu_M,nu_M_u,source\n";
   PlotSeries nu{"nu_M", {}, {}, PlotSeries::Style::line_points}, young{"E_M / E_mu", {}, {}, PlotSeries::Style::line_points, true};
   for (const auto& p : result.curve) {
@@ -147,7 +190,7 @@ void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result,
   write_png_plot(out_dir / "curve.png", PlotSpec{"Calibration curve: tension tests at E_mu = 1 Pa", "r_mu", "nu_M", "E_M / E_mu",
                                                  {nu, young, chosen}});
 
-  std::string md =
+  md +=
       "| material | target E_M GPa | target nu_M | E_mu GPa | r_mu | sample | DEs | achieved E_M GPa | E_M error | achieved nu_M | "
       "nu_M error | reference E_mu GPa | reference r_mu |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   Json pairs = Json::array();
@@ -180,13 +223,20 @@ void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result,
     }
     pairs.push_back(j);
   }
-  write_file_atomically(out_dir / "calibration.md", md);
-  Json summary = Json::object();
-  summary["case_file"] = std::filesystem::absolute(spec.case_file).string();
   summary["plan"] = spec.plan.describe();
   summary["pairs"] = pairs;
+}
+
+void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result, const std::filesystem::path& out_dir) {
+  std::string md;
+  Json summary = Json::object();
+  summary["case_file"] = std::filesystem::absolute(spec.case_file).string();
+  if (!result.curve.empty()) write_elastic(spec, result, out_dir, md, summary);
+  if (!result.strengths.empty()) write_strengths(result, out_dir, md, summary);
+  write_file_atomically(out_dir / "calibration.md", md);
   write_json_atomically(out_dir / "calibration.json", summary);
-  std::printf("\n%s\ncurve: %s\n", md.c_str(), std::filesystem::absolute(out_dir / "curve.png").string().c_str());
+  std::printf("\n%s", md.c_str());
+  if (!result.curve.empty()) std::printf("curve: %s\n", std::filesystem::absolute(out_dir / "curve.png").string().c_str());
 }
 
 }  // namespace
@@ -197,9 +247,12 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
   CalibrationSpec spec;
   spec.case_file = root.existing_file("case");
   spec.bond_key = root.string_or("bond", spec.bond_key);
-  spec.radius_ratios = root.numbers("r_mu", Range::positive(), "1");
-  std::sort(spec.radius_ratios.begin(), spec.radius_ratios.end());
-  if (spec.radius_ratios.size() < 2) root.fail("r_mu", "expected at least two values to interpolate between");
+  const bool elastic = root.has("targets") || !root.has("failure");
+  if (elastic) {
+    spec.radius_ratios = root.numbers("r_mu", Range::positive(), "1");
+    std::sort(spec.radius_ratios.begin(), spec.radius_ratios.end());
+    if (spec.radius_ratios.size() < 2) root.fail("r_mu", "expected at least two values to interpolate between");
+  }
   if (root.has("axes")) {
     spec.axes.clear();
     for (const std::string& a : root.strings("axes")) {
@@ -215,7 +268,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
     v.finish();
   }
   spec.plan = QuasiStatic::read(root.child_if("quasi_static"));
-  for (CaseNode t : root.list("targets")) {
+  for (CaseNode t : elastic ? root.list("targets") : std::vector<CaseNode>{}) {
     CalibrationTarget target{t.string("name"), t.number("E", Range::positive(), "Pa"), t.number("nu", Range::open_between(-1.0, 0.5), "1"),
                              std::nullopt, std::nullopt};
     if (auto ref = t.child_if("reference")) {
@@ -226,11 +279,47 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
     t.finish();
     spec.targets.push_back(target);
   }
+  if (auto failure = root.child_if("failure")) {
+    if (failure->has("axis")) {
+      const std::string a = failure->string("axis");
+      const auto it = std::find(std::begin(axis_names), std::end(axis_names), a);
+      if (it == std::end(axis_names)) failure->fail("axis", "expected x, y or z, got '" + a + "'");
+      spec.failure_axis = int(it - std::begin(axis_names));
+    }
+    spec.failure_tolerance = failure->number_or("tolerance", spec.failure_tolerance, Range::open_between(0.0, 1.0), "1");
+    spec.failure_plan = FailurePlan::read(failure->child_if("test"), FailurePlan{});
+    static constexpr std::string_view criteria[] = {"bbf", "rdef"};
+    for (CaseNode t : failure->list("targets")) {
+      FailureTarget target;
+      target.name = t.string("name");
+      target.criterion = t.choice("criterion", criteria);
+      target.stress = t.number("stress", Range::positive(), "Pa");
+      const auto elastic_target = std::find_if(spec.targets.begin(), spec.targets.end(),
+                                               [&](const CalibrationTarget& e) { return e.name == target.name; });
+      if (elastic_target == spec.targets.end()) {  // the elastic parameters are given
+        target.young = t.number("E", Range::positive(), "Pa (no elastic target of this name to take it from)");
+        target.E_mu = t.number("E_mu", Range::positive(), "Pa (no elastic target of this name to take it from)");
+        target.r_mu = t.number("r_mu", Range::positive(), "1 (no elastic target of this name to take it from)");
+      } else {
+        for (const char* key : {"E", "E_mu", "r_mu"})
+          if (t.has(key)) t.fail(key, "comes from the elastic target '" + target.name + "' calibrated in this spec");
+      }
+      if (t.has("initial")) target.initial = t.number("initial", Range::positive(), "Pa");
+      if (t.has("reference")) target.reference = t.number("reference", Range::positive(), "Pa");
+      if (!target.initial && !target.reference) t.fail("initial", "give a first guess (initial) or a published value (reference)");
+      t.finish();
+      spec.failure_targets.push_back(target);
+    }
+    failure->finish();
+  }
+  if (spec.targets.empty() && spec.failure_targets.empty()) root.fail("targets", "expected elastic targets, failure targets, or both");
   root.finish();
   return spec;
 }
 
-CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir) {
+// The curve and the elastic pairs (header, steps 1-3).
+static void calibrate_elastic(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir,
+                       CalibrationResult& result) {
   // The cache key: the case as resolved with fixed placeholder bond values, and the test plan.
   SceneOptions probe_options = options;
   probe_options.overrides.push_back(spec.bond_key + ".E_mu=1");
@@ -242,7 +331,6 @@ CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& opt
   std::printf("calibration of %s (%s); cache %s\n", spec.case_file.string().c_str(), spec.plan.describe().c_str(),
               cache.file().string().c_str());
 
-  CalibrationResult result;
   const auto point_at = [&](double r_mu, const char* source) {
     for (const auto& p : result.curve)
       if (p.r_mu == r_mu) return p;
@@ -317,8 +405,67 @@ CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& opt
     }
     result.pairs.push_back(pair);
   }
+}
+
+// The strengths (header): tests to failure with s_{n+1} = s_n target / sigma_n.
+static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir,
+                         CalibrationResult& result) {
+  for (const FailureTarget& target : spec.failure_targets) {
+    CalibratedStrength strength;
+    strength.target = target;
+    const auto pair = std::find_if(result.pairs.begin(), result.pairs.end(),
+                                   [&](const CalibratedPair& p) { return p.target.name == target.name; });
+    strength.E_mu = pair != result.pairs.end() ? pair->E_mu : *target.E_mu;
+    strength.r_mu = pair != result.pairs.end() ? pair->r_mu : *target.r_mu;
+    strength.young = pair != result.pairs.end() ? pair->target.young : *target.young;
+    FailurePlan plan = spec.failure_plan;
+    plan.expected_strain = target.stress / strength.young;
+    LoadCase load;
+    load.name = "tension_" + std::string(axis_names[spec.failure_axis]);
+    load.face = load.direction = spec.failure_axis;
+    const bool bbf = target.criterion == "bbf";
+    if (!bbf) {  // the RDEF threshold alone must decide
+      const Scene probe = build_scene(spec.case_file, options);
+      for (const auto& set : probe.dem.bond_sets())
+        if (set->has_strength())
+          throw InputError(spec.case_file.string() + ": bond set '" + set->name + "' has a BBF strength (sigma_f); the RDEF target '" +
+                           target.name + "' needs a case without one");
+    }
+    double threshold = target.initial ? *target.initial : *target.reference;
+    for (int round = 0; round < 5; ++round) {
+      SceneOptions o = options;
+      o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", strength.E_mu));
+      o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", strength.r_mu));
+      o.overrides.push_back(bbf ? spec.bond_key + ".sigma_f=" + format("%.17g", threshold)
+                                : "dem.failure.rdef.threshold=" + format("%.17g", threshold));
+      o.out_dir = out_dir / target.name / ("failure_" + target.criterion) / ("round_" + std::to_string(round));
+      const FailureTestResult test = run_failure_test(spec.case_file, o, load, plan);
+      strength.rounds.push_back({threshold, test});
+      const double error = test.peak_stress / target.stress - 1.0;
+      std::printf("%s %s round %d: threshold %.6g GPa -> sigma_M = %.5g GPa at strain %.4g (target %.5g GPa, %+.2f %%), %.0f s\n",
+                  target.name.c_str(), target.criterion.c_str(), round, threshold * 1e-9, test.peak_stress * 1e-9,
+                  test.strain_at_peak, target.stress * 1e-9, 100.0 * error, test.wall_seconds);
+      std::fflush(stdout);
+      if (!test.broke)
+        throw RunError("calibrate: " + target.name + " (" + target.criterion + ") did not break by strain " +
+                       format("%.4g", test.final_strain) + "; raise failure.test.max_strain_factor or lower the first guess");
+      if (std::abs(error) <= spec.failure_tolerance) {
+        strength.converged = true;
+        break;
+      }
+      threshold *= target.stress / test.peak_stress;
+    }
+    result.strengths.push_back(strength);
+  }
+}
+
+CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir) {
+  CalibrationResult result;
+  if (!spec.targets.empty()) calibrate_elastic(spec, options, out_dir, result);
+  calibrate_strengths(spec, options, out_dir, result);
   write_outputs(spec, result, out_dir);
   return result;
 }
+
 
 }  // namespace arlequin::app

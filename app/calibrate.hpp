@@ -16,6 +16,14 @@
 // next to the sample file (calibration_cache.json), keyed by the case as resolved and the test
 // plan, so a second calibration on the same packing only runs what is new.
 //
+// Failure calibration (DESIGN.md section 3; seed Table 1's sigma_f_mu): at fixed elastic
+// micro parameters the sample's macroscopic tensile failure stress is proportional to the
+// micro strength (every bond force scales with it up to the first break, and the cascade after
+// it is the same in units of the failure strain), so, from a first guess s_0, tests to failure
+// (virtual_tests.hpp, run_failure_test) give sigma_n and s_{n+1} = s_n target / sigma_n, until
+// |sigma_n / target - 1| <= the failure tolerance (at most 5 rounds). The criterion is BBF (the
+// bond's sigma_f) or RDEF (dem.failure.rdef.threshold, the bond left without sigma_f).
+//
 // Averages over n axes: the mean, uncertainty sqrt(sum u_i^2 / n^2 + s^2 / n), s the spread
 // (standard deviation) between the axes; nu_M pools both lateral ratios of every axis.
 #pragma once
@@ -36,6 +44,15 @@ struct CalibrationTarget {
   std::optional<double> reference_E_mu, reference_r_mu;  // a published pair (seed Table 1), for the report
 };
 
+// A macroscopic tensile strength to reproduce with one failure criterion.
+struct FailureTarget {
+  std::string name;       // an elastic target's name: its calibrated pair and E are used
+  std::string criterion;  // "bbf" or "rdef"
+  double stress = 0.0;    // Pa, sigma_f macro
+  std::optional<double> young, E_mu, r_mu;     // Pa, Pa, 1: required without an elastic target of that name
+  std::optional<double> initial, reference;   // Pa: first guess (default: reference), a published value
+};
+
 // Spec file (strict YAML; `arlequin calibrate SPEC.yaml`):
 //   case: sample.yaml        one-material case: a packing, density, a beam bond law with nu_mu
 //   bond: dem.bond           key path of the bond section whose E_mu and r_mu are calibrated
@@ -46,7 +63,13 @@ struct CalibrationTarget {
 //                            each its own sample file (name= or dem.sample.file=), else its
 //                            packing replaces the calibration sample's cached one
 //   quasi_static: {...}      QuasiStatic (virtual_tests.hpp)
-//   targets: [{name, E [Pa], nu, reference: {E_mu [Pa], r_mu}}]
+//   targets: [{name, E [Pa], nu, reference: {E_mu [Pa], r_mu}}]   (optional with failure)
+//   failure:                 optional: strengths, after the elastic pairs
+//     axis: z                tension axis of the tests to failure
+//     tolerance: 0.02        relative, on the failure stress
+//     test: {...}            FailurePlan (virtual_tests.hpp); expected_strain = stress / E
+//     targets: [{name, criterion: bbf | rdef, stress [Pa], E [Pa], E_mu [Pa], r_mu, initial [Pa],
+//                reference [Pa]}]
 struct CalibrationSpec {
   std::filesystem::path case_file;
   std::string bond_key = "dem.bond";
@@ -60,6 +83,10 @@ struct CalibrationSpec {
   std::vector<Variant> verify;
   QuasiStatic plan;
   std::vector<CalibrationTarget> targets;
+  std::vector<FailureTarget> failure_targets;
+  FailurePlan failure_plan;
+  int failure_axis = 2;
+  double failure_tolerance = 0.02;
 
   static CalibrationSpec read(const std::filesystem::path& spec_file);  // InputError at the key
 };
@@ -88,14 +115,27 @@ struct CalibratedPair {
   std::vector<Measurement> achieved;  // the calibration sample first, then the verify variants
 };
 
+struct CalibratedStrength {
+  FailureTarget target;
+  double E_mu = 0.0, r_mu = 0.0, young = 0.0;  // Pa, 1, Pa: the elastic parameters used
+  struct Round {
+    double threshold;  // Pa: sigma_f (bbf) or the RDEF threshold
+    FailureTestResult test;
+  };
+  std::vector<Round> rounds;  // the last one is the result
+  bool converged = false;
+};
+
 struct CalibrationResult {
   std::vector<CurvePoint> curve;  // sorted by r_mu
   std::vector<CalibratedPair> pairs;
+  std::vector<CalibratedStrength> strengths;
 };
 
-// Runs the calibration into out_dir (runs in out_dir/curve/r_<r_mu>/<axis>/ and
-// out_dir/<target>/<sample>/<axis>/), writes curve.csv, curve.png, calibration.md and calibration.json
-// there, and prints the curve and the pairs. options' overrides apply to the case. InputError
+// Runs the calibration into out_dir (runs in out_dir/curve/r_<r_mu>/<axis>/,
+// out_dir/<target>/<sample>/<axis>/ and out_dir/<target>/failure_<criterion>/round_<n>/), writes
+// curve.csv, curve.png (with elastic targets), strength.csv (with failure targets),
+// calibration.md and calibration.json there, and prints the curve, the pairs and strengths. options' overrides apply to the case. InputError
 // if a target's nu_M is outside the curve's range (widen r_mu); RunError if a run stops.
 CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir);
 

@@ -32,8 +32,10 @@ constexpr const char* usage_main =
     "  check CASE.yaml   validate a case, print it with defaults and its critical time step\n"
     "  sweep CASE.yaml   run a case over several values of its keys; table of errors and run times\n"
     "  build-sample CASE.yaml   build the case's packing (dem.sample.build: packing) and save it\n"
-    "  virtual-test SPEC.yaml   quasi-static tension/shear tests of a sample: moduli, Poisson ratios\n"
-    "  calibrate SPEC.yaml      fit beam bonds (E_mu, r_mu) to a material's (E_M, nu_M) on a packing\n"
+    "  virtual-test SPEC.yaml   quasi-static tension/shear tests of a sample (moduli, Poisson ratios),\n"
+    "                           or tension tests to failure (failure stress and strain, broken bonds)\n"
+    "  calibrate SPEC.yaml      fit beam bonds (E_mu, r_mu) to a material's (E_M, nu_M) on a packing,\n"
+    "                           and BBF / RDEF strengths to its tensile failure stress\n"
     "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
@@ -64,15 +66,18 @@ constexpr const char* usage_virtual_test =
     "  runs the spec's quasi-static tests (tension, shear) on each of its samples (only the named\n"
     "  ones with --sample), results in DIR/<sample>/<test>/ (default results/<folder>_<spec>/);\n"
     "  prints moduli and Poisson ratios with their uncertainty, writes DIR/tests.csv and, for a\n"
-    "  composite spec, DIR/composite.md (engineering constants against closed forms and references).\n"
+    "  composite spec, DIR/composite.md (engineering constants against closed forms and references);\n"
+    "  with a failure section every test runs to failure: DIR/failure.csv and DIR/failure.md.\n"
     "  --set applies to the sample case. Spec format: app/virtual_tests.hpp\n";
 
 constexpr const char* usage_calibrate =
     "usage: arlequin calibrate SPEC.yaml [--out DIR] [--set k=v ...]\n"
     "  fits the beam bonds' (E_mu, r_mu) of a one-material packing to target (E_M, nu_M): tension\n"
     "  tests over the spec's r_mu grid (nu_M depends on r_mu only), then E_mu by proportionality;\n"
-    "  a verification run per target. Writes curve.csv, curve.png, calibration.md/.json to DIR\n"
-    "  (default results/<folder>_<spec>/); curve points are cached next to the sample file.\n"
+    "  a verification run per target. With a failure section: sigma_f_mu (BBF) or the RDEF threshold\n"
+    "  reproducing a tensile failure stress, by tests to failure. Writes curve.csv, curve.png,\n"
+    "  strength.csv, calibration.md/.json to DIR (default results/<folder>_<spec>/); curve points\n"
+    "  are cached next to the sample file. Exit 5 if a strength did not converge.\n"
     "  --set applies to the sample case. Spec format: app/calibrate.hpp\n";
 
 constexpr const char* usage_sweep =
@@ -253,8 +258,14 @@ int calibrate(const Arguments& a) {
   app::SceneOptions base = a.scene;
   base.out_dir.clear();
   const std::filesystem::path out = spec_out_dir(a);
-  app::calibrate(app::CalibrationSpec::read(a.case_file), base, out);
+  const app::CalibrationResult result = app::calibrate(app::CalibrationSpec::read(a.case_file), base, out);
   std::printf("results: %s\n", std::filesystem::absolute(out).string().c_str());
+  for (const auto& s : result.strengths)
+    if (!s.converged) {
+      std::fprintf(stderr, "calibrate: the %s strength of %s did not reach the failure tolerance in %zu rounds\n",
+                   s.target.criterion.c_str(), s.target.name.c_str(), s.rounds.size());
+      return 5;
+    }
   return 0;
 }
 

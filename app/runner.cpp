@@ -310,6 +310,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     if (current_time() + slack >= next_row || steps_done == total_steps) {
       result.sensors = outputs.write_row(current_time(), steps_done, result.energies, initial_total);
       next_row += scene.output.every;
+      if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
     }
     if (current_time() + slack >= next_frame || steps_done == total_steps) {
       outputs.write_fields(current_time());
@@ -337,6 +338,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
         model.check_energy(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
       if (current_time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
       progress.update(n, current_time());
+      if (!result.stop_reason.empty()) break;
     }
   } catch (const RunError& e) {
     failure = e.what();
@@ -354,6 +356,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["version"] = ARLEQUIN_VERSION;
   summary["status"] = failure.empty() ? "completed" : "failed";
   if (!failure.empty()) summary["error"] = failure;
+  if (!result.stop_reason.empty()) summary["stopped_early"] = result.stop_reason;
   summary["steps"] = result.steps;
   summary["simulated_time"] = result.simulated_time;
   summary["dt"] = scene.dt;

@@ -5,6 +5,7 @@
 // far are flushed and closed, summary.json records the failure, and the error is rethrown.
 #pragma once
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +18,10 @@ struct RunOptions {
   long max_steps = -1;         // --steps N: stop after N steps (< 0: run to the end time)
   bool show_progress = false;  // progress line on stderr (a terminal, not CI)
   double setup_seconds = 0.0;  // wall time spent building the scene, for the summary
+  // Called after each series.csv row with the row's sensor values (column, value); a
+  // non-empty answer ends the run there as completed, with that reason in the summary
+  // (e.g. a test to failure once the sample has broken).
+  std::function<std::string(const std::vector<std::pair<std::string, double>>&)> stop_after_row;
 };
 
 struct RunResult {
@@ -25,6 +30,7 @@ struct RunResult {
   double wall_seconds = 0.0;    // time loop only
   dem::Energies energies;
   std::vector<std::pair<std::string, double>> sensors;  // last value of each column
+  std::string stop_reason;      // why stop_after_row ended the run early (empty: it did not)
   struct CheckResult {
     const Check* check;
     double value;           // final value, or crossing time (NaN: never reached)

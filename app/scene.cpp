@@ -115,7 +115,7 @@ void read_bonds(CaseNode bond, dem::DemModel& model, double default_tolerance) {
 // and a group named after it. A bond between two DEs of one material uses that material's bond
 // law and parameters; a bond across materials uses dem.interface. Bond sets are named after
 // their material (and "interface"), so records and outputs say fibre, matrix, interface.
-void read_materials(CaseNode dem_node, dem::DemModel& model, double default_tolerance) {
+std::vector<std::string> read_materials(CaseNode dem_node, dem::DemModel& model, double default_tolerance) {
   CaseNode materials = dem_node.child("materials");
   struct Material {
     std::string name;
@@ -182,15 +182,41 @@ void read_materials(CaseNode dem_node, dem::DemModel& model, double default_tole
     dem::BondSet* set = a == b ? set_of[a] : interface;
     if (set) set->add(i, j, p);
   }
-  for (std::size_t m = 0; m < list.size(); ++m) materials.child_named(list[m].name).finish();
+  std::vector<std::string> names;
+  for (std::size_t m = 0; m < list.size(); ++m) {
+    materials.child_named(list[m].name).finish();
+    names.push_back(list[m].name);
+  }
+  return names;
 }
 
-void read_failure(CaseNode failure, dem::DemModel& model) {
-  // BBF strengths belong to the bond laws (sigma_f, max_elongation); RDEF is per DE.
+// `materials`: the case's material names (empty without dem.materials).
+void read_failure(CaseNode failure, dem::DemModel& model, const std::vector<std::string>& materials) {
+  // BBF strengths belong to the bond laws (sigma_f, max_elongation); RDEF is per DE, with a
+  // threshold per material (material_thresholds) or one for every DE (threshold).
   if (auto rdef = failure.child_if("rdef")) {
     static constexpr std::string_view equivalents[] = {"max_principal", "von_mises"};
     dem::DemModel::RdefSettings settings;
-    settings.threshold = rdef->number("threshold", Range::positive(), "Pa");
+    std::vector<std::string> missing = materials;
+    if (auto per_material = rdef->child_if("material_thresholds")) {
+      if (materials.empty()) rdef->fail("material_thresholds", "needs dem.materials; give one threshold instead");
+      for (const std::string& name : per_material->keys()) {
+        const auto it = std::find(missing.begin(), missing.end(), name);
+        if (it == missing.end()) per_material->fail(name, "no material of that name (or listed twice)");
+        missing.erase(it);
+        settings.group_thresholds.emplace_back(model.group_index(name), per_material->number(name, Range::positive(), "Pa"));
+      }
+      per_material->finish();
+    }
+    if (materials.empty() || !missing.empty()) {
+      std::string which;
+      for (const auto& m : missing) which += (which.empty() ? "" : ", ") + m;
+      settings.threshold = rdef->number("threshold", Range::positive(),
+                                        materials.empty() ? "Pa" : "Pa (for the materials without their own: " + which + ")");
+    } else {
+      settings.threshold = std::numeric_limits<double>::infinity();  // every DE has its material's
+      if (rdef->has("threshold")) rdef->fail("threshold", "every material has its own threshold in material_thresholds");
+    }
     settings.von_mises = rdef->choice_or("equivalent", "max_principal", equivalents) == "von_mises";
     settings.compaction = rdef->number_or("compaction", 0.63, Range::open_between(0.0, 1.0), "1");
     rdef->finish();
@@ -256,6 +282,7 @@ void read_boundary(CaseNode root, dem::DemModel& model) {
                 : kind == "displacement" ? BoundaryKind::displacement : BoundaryKind::force;
       bc.value = b.vec3("value", Range::any(), kind == "velocity" ? "m/s" : kind == "force" ? "N" : "m");
       if (bc.kind == BoundaryKind::displacement) bc.ramp = b.number("ramp", Range::positive(), "s");
+      if (bc.kind == BoundaryKind::velocity) bc.rise = b.number_or("rise", 0.0, Range::non_negative(), "s");
       if (bc.kind != BoundaryKind::force) bc.lock_rotation = b.choice_or("rotation", "free", rotations) == "fixed";
     }
     if (bc.kinematic() && b.has("components")) {
@@ -483,12 +510,13 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (!dem_node && !continuum_node) root.fail("dem", "a case needs a dem section, a continuum section, or both");
   dem::DemModel& model = scene.dem;
   if (dem_node) {
+    std::vector<std::string> materials;
     if (dem_node->has("materials")) {
       for (const char* single : {"density", "bond"})
         if (dem_node->has(single))
           dem_node->fail(single, "give either dem.materials or dem.density and dem.bond, not both");
       read_sample(dem_node->child("sample"), scene, 1.0, options);
-      read_materials(*dem_node, model, default_bond_tolerance(scene));
+      materials = read_materials(*dem_node, model, default_bond_tolerance(scene));
     } else {
       const double density = dem_node->number("density", Range::positive(), "kg/m^3");
       read_sample(dem_node->child("sample"), scene, density, options);
@@ -503,7 +531,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       contact->finish();
     }
     model.set_damping(dem_node->number_or("damping", 0.0, Range::non_negative(), "1/s"));
-    if (auto failure = dem_node->child_if("failure")) read_failure(*failure, model);
+    if (auto failure = dem_node->child_if("failure")) read_failure(*failure, model, materials);
     dem_node->finish();
   }
   if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, options.petsc_options);

@@ -9,10 +9,12 @@
 //   dem:     {sample: {build: lattice | chain | particles, ...}, density [kg/m^3],
 //             bond: {law: <bond law>, tolerance, ...law parameters},      (optional)
 //             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
-//             damping [1/s], failure: {rdef: {threshold [Pa], equivalent, compaction}}}
+//             damping [1/s], failure: {rdef: {threshold [Pa], material_thresholds: {<material>: [Pa]},
+//                                                equivalent, compaction}}}
 //             (BBF strengths are bond-law parameters: sigma_f for beams, max_elongation for springs)
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
-//   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rotation}]
+//   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rise, rotation,
+//               components}]
 //   initial:  [{group, velocity [m/s], angular_velocity [rad/s]}]
 //   initial_strain: {gradient: [[..], [..], [..]]}: start from u = H x (DEM and continuum)
 //   pulse:    {group, direction, center [m], wavelength [m], amplitude [m/s], speed [m/s]}: a

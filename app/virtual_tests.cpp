@@ -150,10 +150,10 @@ std::vector<int> slab_axes(const LoadCase& load) {
   return axes;
 }
 
-// The generated sections of one test (header), as --set overrides.
-std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase& load, const QuasiStatic& plan,
-                                        double transit, double damping) {
-  const std::string axis(axis_names[load.face]), dir(axis_names[load.direction]);
+// The slabs of the test's faces as groups, displacement sensors on every slab (the loaded
+// component on the loaded faces, the normal one on the others), force sensors on both
+// loaded faces; as --set overrides, with no checks of the case's own.
+std::vector<std::string> gauge_overrides(const SampleGeometry& g, const LoadCase& load) {
   std::string groups, sensors;
   for (int k : slab_axes(load)) {
     for (bool upper : {false, true}) {
@@ -165,10 +165,19 @@ std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase&
   }
   for (bool upper : {false, true})
     sensors += std::string(", {name: ") + (upper ? "F_moved" : "F_held") + ", type: force, group: " +
-               group_name(load.face, upper) + ", component: " + dir + "}";
+               group_name(load.face, upper) + ", component: " + std::string(axis_names[load.direction]) + "}";
+  return {"groups=[" + groups + "]", "sensors=[" + sensors + "]", "checks=[]"};
+}
+
+std::string vec3_yaml(const Vec3& v) { return "[" + number_text(v.x) + ", " + number_text(v.y) + ", " + number_text(v.z) + "]"; }
+
+// The generated sections of one quasi-static test (header), as --set overrides.
+std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase& load, const QuasiStatic& plan,
+                                        double transit, double damping) {
+  const std::string axis(axis_names[load.face]);
   Vec3 motion{};
   motion[load.direction] = plan.strain * g.length(load.face);
-  const std::string value = "[" + number_text(motion.x) + ", " + number_text(motion.y) + ", " + number_text(motion.z) + "]";
+  const std::string value = vec3_yaml(motion);
   const std::string ramp = number_text(plan.ramp * transit);
   const std::string boundary =
       load.shear() ? "[{group: " + group_name(load.face, false) + ", type: fixed}, {group: " + group_name(load.face, true) +
@@ -176,21 +185,25 @@ std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase&
                    : "[{group: " + group_name(load.face, false) + ", type: velocity, value: [0, 0, 0], components: [" + axis +
                          "]}, {group: " + group_name(load.face, true) + ", type: displacement, value: " + value +
                          ", ramp: " + ramp + ", components: [" + axis + "]}]";
-  return {"groups=[" + groups + "]",
-          "boundary=" + boundary,
-          "sensors=[" + sensors + "]",
-          "checks=[]",
-          "time.end=" + number_text((plan.ramp + plan.plateau) * transit),
-          "output.every=" + number_text(transit / plan.rows_per_transit),
-          "dem.damping=" + number_text(damping)};
+  std::vector<std::string> o = gauge_overrides(g, load);
+  o.insert(o.end(), {"boundary=" + boundary, "time.end=" + number_text((plan.ramp + plan.plateau) * transit),
+                     "output.every=" + number_text(transit / plan.rows_per_transit), "dem.damping=" + number_text(damping)});
+  return o;
 }
 
-// Mean reference coordinate along `axis` of the DEs of a face slab.
-double centroid(const dem::DemModel& model, int axis, bool upper) {
-  const auto ids = model.members(model.group_index(group_name(axis, upper)));
+// Mean reference coordinate along `axis` of the DEs of a face slab (those slab_yaml selects).
+double centroid(const dem::ParticleSet& p, const SampleGeometry& g, int axis, bool upper) {
+  const double t = 2.0 * g.mean_radius;
   double s = 0.0;
-  for (auto i : ids) s += model.particles.reference[i][axis];
-  return s / double(ids.size());
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double x = p.reference[i][axis];
+    if (upper ? x >= g.upper[axis] - t : x <= g.lower[axis] + t) s += x, ++n;
+  }
+  return s / double(n);
+}
+double gauge_length(const dem::ParticleSet& p, const SampleGeometry& g, int axis) {
+  return centroid(p, g, axis, true) - centroid(p, g, axis, false);
 }
 
 Json estimate_json(const Estimate& e) {
@@ -374,6 +387,7 @@ LoadCase LoadCase::read(CaseNode& node) {
     if (load.face == load.direction) node.fail("shear", "the direction must differ from the face normal (that is tension)");
   }
   if (node.has("modulus_estimate")) load.modulus_estimate = node.number("modulus_estimate", Range::positive(), "Pa");
+  load.overrides = node.strings_or("set", {});
   return load;
 }
 
@@ -396,29 +410,67 @@ std::string QuasiStatic::describe() const {
          shortest(rows_per_transit) + " rows per T";
 }
 
+namespace {
+
+// What every test needs before its run: a probe of the case (with the test's own overrides)
+// gives the sample's extent, the modulus behind the time scale and the damping rate.
+struct TestSetup {
+  SceneOptions options;  // the caller's, then the test's own overrides
+  Scene probe;
+  SampleGeometry geometry;
+  double modulus = 0.0;  // Pa
+  bool affine = false;
+  double transit = 0.0;  // s
+  double damping = 0.0;  // 1/s
+
+  TestSetup(const std::filesystem::path& case_file, const SceneOptions& caller, const LoadCase& load, double zeta)
+      : options(with_test_overrides(caller, load)), probe(build_scene(case_file, options)), geometry(probe.dem.particles) {
+    if (options.out_dir.empty()) throw InputError("virtual test " + load.name + ": no output folder given");
+    affine = !load.modulus_estimate;
+    modulus = load.modulus_estimate ? *load.modulus_estimate : affine_modulus(probe.dem, geometry, load);
+    if (!(modulus > 0.0)) throw InputError(case_file.string() + ": the sample has no bond stiffness to test");
+    transit = geometry.length(load.face) / std::sqrt(modulus / geometry.density);
+    damping = zeta * 2.0 * std::numbers::pi / transit;
+  }
+  static SceneOptions with_test_overrides(SceneOptions o, const LoadCase& load) {
+    o.overrides.insert(o.overrides.end(), load.overrides.begin(), load.overrides.end());
+    return o;
+  }
+  // Builds and runs the test scene: the probe's options plus `generated`.
+  std::pair<Scene, RunResult> run(const std::filesystem::path& case_file, const std::vector<std::string>& generated,
+                                  const RunOptions& run_options = {}) const {
+    SceneOptions o = options;
+    o.overrides.insert(o.overrides.end(), generated.begin(), generated.end());
+    Scene scene = build_scene(case_file, o);
+    RunResult result = run_scene(scene, run_options);
+    return {std::move(scene), std::move(result)};
+  }
+};
+
+std::size_t bond_count(const dem::DemModel& model) {
+  std::size_t n = 0;
+  for (const auto& set : model.bond_sets()) n += set->size();
+  return n;
+}
+
+}  // namespace
+
 VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const SceneOptions& options,
                                    const LoadCase& load, const QuasiStatic& plan) {
-  if (options.out_dir.empty()) throw InputError("run_virtual_test: no output folder given");
   const auto t0 = std::chrono::steady_clock::now();
+  const TestSetup setup(case_file, options, load, plan.damping);
+  const SampleGeometry& g = setup.geometry;
   VirtualTestResult r;
   r.load = load;
   r.out_dir = options.out_dir;
-  // A probe of the plain case gives the sample's extent and the affine modulus.
-  const Scene probe = build_scene(case_file, options);
-  const SampleGeometry g(probe.dem.particles);
-  r.affine_estimate = !load.modulus_estimate;
-  r.modulus_used = load.modulus_estimate ? *load.modulus_estimate : affine_modulus(probe.dem, g, load);
-  if (!(r.modulus_used > 0.0)) throw InputError(case_file.string() + ": the sample has no bond stiffness to test");
-  r.transit_time = g.length(load.face) / std::sqrt(r.modulus_used / g.density);
-  r.damping = plan.damping * 2.0 * std::numbers::pi / r.transit_time;
-
-  SceneOptions test_options = options;
-  for (auto& o : test_overrides(g, load, plan, r.transit_time, r.damping)) test_options.overrides.push_back(std::move(o));
-  Scene scene = build_scene(case_file, test_options);
-  const RunResult run = run_scene(scene, RunOptions{});
+  r.affine_estimate = setup.affine;
+  r.modulus_used = setup.modulus;
+  r.transit_time = setup.transit;
+  r.damping = setup.damping;
+  const auto [scene, run] = setup.run(case_file, test_overrides(g, load, plan, r.transit_time, r.damping));
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.particles = scene.dem.particles.size();
-  for (const auto& set : scene.dem.bond_sets()) r.bonds += set->size();
+  r.bonds = bond_count(scene.dem);
   r.steps = run.steps;
   r.dt = scene.dt;
   r.kinetic_to_bond = run.energies.kinetic / run.energies.bond;
@@ -440,7 +492,7 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   // Strain between the slabs of axis k (their sensors record the loaded component).
   Json gauges = Json::object();
   const auto strain_between = [&](int k) {
-    const double gauge = centroid(scene.dem, k, true) - centroid(scene.dem, k, false);
+    const double gauge = gauge_length(scene.dem.particles, g, k);
     gauges[std::string(axis_names[k])] = gauge;
     const auto upper = column(displacement_column(k, true)), lower = column(displacement_column(k, false));
     std::vector<double> e(upper.size());
@@ -492,6 +544,147 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   return r;
 }
 
+FailurePlan FailurePlan::read(std::optional<CaseNode> node, const FailurePlan& defaults) {
+  FailurePlan f = defaults;
+  if (!node) return f;
+  f.expected_strain = node->number_or("expected_strain", f.expected_strain, Range::open_between(0.0, 0.5), "1");
+  f.transits = node->number_or("transits", f.transits, Range::positive(), "transit times");
+  f.max_strain_factor = node->number_or("max_strain_factor", f.max_strain_factor, Range::at_least(1.0), "1");
+  f.stop_below = node->number_or("stop_below", f.stop_below, Range::open_between(0.0, 1.0), "1");
+  f.damping = node->number_or("damping", f.damping, Range::non_negative(), "1");
+  f.rise = node->number_or("rise", f.rise, Range::non_negative(), "transit times");
+  f.rows_per_transit = node->number_or("rows_per_transit", f.rows_per_transit, Range::at_least(2.0), "1");
+  f.frames = static_cast<int>(node->number_or("frames", f.frames, Range::between(0.0, 10000.0), "1"));
+  node->finish();
+  return f;
+}
+
+std::string FailurePlan::describe() const {
+  return "expected strain " + shortest(expected_strain) + " after " + shortest(transits) + " T (rise " + shortest(rise) +
+         " T), end below " + shortest(stop_below) + " of the peak or at " + shortest(max_strain_factor) +
+         " x the expected strain, damping " + shortest(damping) + " of critical, " + shortest(rows_per_transit) + " rows per T";
+}
+
+FailureTestResult run_failure_test(const std::filesystem::path& case_file, const SceneOptions& options, const LoadCase& load,
+                                   const FailurePlan& plan) {
+  if (load.shear()) throw InputError("test " + load.name + ": a test to failure is a tension test");
+  const auto t0 = std::chrono::steady_clock::now();
+  const TestSetup setup(case_file, options, load, plan.damping);
+  if (!setup.probe.dem.failure_enabled())
+    throw InputError(case_file.string() + ": test " + load.name +
+                     " runs to failure but the case has no failure criterion (a bond law's sigma_f, or dem.failure.rdef)");
+  const SampleGeometry& g = setup.geometry;
+  const int a = load.face;
+  const double area = g.area(a), gauge = gauge_length(setup.probe.dem.particles, g, a);
+  FailureTestResult r;
+  r.load = load;
+  r.out_dir = options.out_dir;
+  r.transit_time = setup.transit;
+  r.damping = setup.damping;
+  r.velocity = plan.expected_strain * g.length(a) / (plan.transits * setup.transit);
+  // Displacement v (t - rise / 2) after the rise: the end strain is max_strain_factor x expected.
+  const double rise = plan.rise * setup.transit;
+  const double end = plan.max_strain_factor * plan.expected_strain * g.length(a) / r.velocity + 0.5 * rise;
+  const std::string axis(axis_names[a]);
+  Vec3 velocity{};
+  velocity[a] = r.velocity;
+  std::string sets;
+  for (const auto& set : setup.probe.dem.bond_sets()) sets += (sets.empty() ? "" : ", ") + ("broken_" + set->name);
+  std::vector<std::string> generated = gauge_overrides(g, load);
+  generated.insert(generated.end(),
+                   {"boundary=[{group: " + group_name(a, false) + ", type: velocity, value: [0, 0, 0], components: [" + axis +
+                        "]}, {group: " + group_name(a, true) + ", type: velocity, value: " + vec3_yaml(velocity) +
+                        ", rise: " + number_text(rise) + ", components: [" + axis + "]}]",
+                    "time.end=" + number_text(end), "output.every=" + number_text(setup.transit / plan.rows_per_transit),
+                    "dem.damping=" + number_text(setup.damping),
+                    // Seed Figs. 5-6: broken bonds per group and the stress against the strain.
+                    "output.plots=[{file: failure.png, title: 'Tension to failure: " + load.name + "', x: " +
+                        displacement_column(a, true) + ", x_scale: " + number_text(1.0 / gauge) +
+                        ", x_label: strain, y: [F_moved], y_scale: " + number_text(1e-9 / area) +
+                        ", y_label: stress GPa, y2: [" + sets + "], y2_scale: 100, y2_label: broken bonds %}]"});
+  if (plan.frames > 0)
+    generated.insert(generated.end(), {"output.fields=[particles, bonds]", "output.fields_every=" + number_text(end / plan.frames)});
+
+  // The stress on the moved face, row by row; stop once it has fallen well below its peak.
+  double peak = 0.0;
+  RunOptions run_options;
+  const std::string moved = displacement_column(a, true), held = displacement_column(a, false);
+  run_options.stop_after_row = [&](const std::vector<std::pair<std::string, double>>& row) -> std::string {
+    double force = 0.0, upper = 0.0, lower = 0.0;
+    for (const auto& [name, value] : row) {
+      if (name == "F_moved") force = value;
+      if (name == moved) upper = value;
+      if (name == held) lower = value;
+    }
+    const double stress = force / area, strain = (upper - lower) / gauge;
+    peak = std::max(peak, stress);
+    if (strain > 0.2 * plan.expected_strain && stress < plan.stop_below * peak)
+      return "the stress fell below " + shortest(plan.stop_below) + " of its peak";
+    return {};
+  };
+  const auto [scene, run] = setup.run(case_file, generated, run_options);
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.particles = scene.dem.particles.size();
+  r.bonds = bond_count(scene.dem);
+  r.steps = run.steps;
+  r.dt = scene.dt;
+  r.broke = !run.stop_reason.empty();
+  r.breaks = scene.dem.breaks().size();
+  r.fracture_energy = run.energies.fracture;
+
+  const SeriesTable series = SeriesTable::read(scene.output.dir / "series.csv");
+  const std::size_t force = series.column("F_moved"), upper = series.column(moved), lower = series.column(held);
+  const auto stress_of = [&](const std::vector<double>& row) { return row[force] / area; };
+  const auto strain_of = [&](const std::vector<double>& row) { return (row[upper] - row[lower]) / gauge; };
+  std::size_t at_peak = 0;
+  for (std::size_t i = 0; i < series.rows.size(); ++i)
+    if (stress_of(series.rows[i]) > stress_of(series.rows[at_peak])) at_peak = i;
+  r.peak_stress = stress_of(series.rows[at_peak]);
+  r.strain_at_peak = strain_of(series.rows[at_peak]);
+  r.final_stress = stress_of(series.rows.back());
+  r.final_strain = strain_of(series.rows.back());
+  for (const auto& row : series.rows)
+    if (stress_of(row) >= 0.5 * r.peak_stress) {
+      r.secant_modulus = stress_of(row) / strain_of(row);
+      break;
+    }
+  for (const auto& set : scene.dem.bond_sets()) {
+    const std::size_t c = series.column("broken_" + set->name);
+    r.broken_at_peak.emplace_back(set->name, series.rows[at_peak][c]);
+    r.broken_at_end.emplace_back(set->name, series.rows.back()[c]);
+  }
+
+  Json j = Json::object();
+  j["case_file"] = std::filesystem::absolute(case_file).string();
+  j["test"] = load.name;
+  j["load"] = load.describe() + ", to failure";
+  j["plan"] = plan.describe();
+  j["transit_time"] = r.transit_time;
+  j["modulus_estimate"] = setup.modulus;
+  j["damping"] = r.damping;
+  j["velocity"] = r.velocity;
+  j["failure_stress"] = r.peak_stress;
+  j["failure_strain"] = r.strain_at_peak;
+  j["secant_modulus"] = r.secant_modulus;
+  j["final_stress"] = r.final_stress;
+  j["final_strain"] = r.final_strain;
+  j["broke"] = r.broke;
+  Json& peak_json = j["broken_at_peak"];
+  for (const auto& [name, f] : r.broken_at_peak) peak_json[name] = f;
+  Json& end_json = j["broken_at_end"];
+  for (const auto& [name, f] : r.broken_at_end) end_json[name] = f;
+  j["breaks"] = r.breaks;
+  j["fracture_energy"] = r.fracture_energy;
+  j["gauge_length"] = gauge;
+  j["particles"] = r.particles;
+  j["bonds"] = r.bonds;
+  j["steps"] = r.steps;
+  j["dt"] = r.dt;
+  j["wall_seconds"] = r.wall_seconds;
+  write_json_atomically(scene.output.dir / "test.json", j);
+  return r;
+}
+
 namespace {
 
 // One line per test for the console.
@@ -505,6 +698,102 @@ std::string describe_result(const VirtualTestResult& r) {
   line += format(", imbalance %.1e", r.force_imbalance) + ", " + std::to_string(r.particles) + " DEs, " +
           std::to_string(r.steps) + " steps" + format(", wall %.1f s", r.wall_seconds);
   return line;
+}
+
+}  // namespace
+
+namespace {
+
+// A published range for a test to failure (e.g. seed Table 4 over its samples).
+struct FailureReference {
+  std::string name;
+  std::array<double, 2> stress{}, strain{};  // Pa; 1
+  std::vector<std::pair<std::string, std::array<double, 2>>> broken;  // bond set, percent
+
+  static std::optional<FailureReference> read(std::optional<CaseNode> node) {
+    if (!node) return std::nullopt;
+    const auto range = [](CaseNode& n, std::string_view key, const char* unit) {
+      const auto v = n.numbers(key, Range::non_negative(), unit);
+      if (v.size() != 2 || v[0] > v[1]) n.fail(key, "expected a range [low, high]");
+      return std::array<double, 2>{v[0], v[1]};
+    };
+    FailureReference r;
+    r.name = node->string("name");
+    r.stress = range(*node, "stress", "Pa");
+    r.strain = range(*node, "strain", "1");
+    if (auto broken = node->child_if("broken")) {
+      for (const std::string& set : broken->keys()) r.broken.emplace_back(set, range(*broken, set, "%"));
+      broken->finish();
+    }
+    node->finish();
+    return r;
+  }
+};
+
+// "fibre 4.1, matrix 40, ..." (percent); `separator` "; " keeps a CSV cell free of commas.
+std::string broken_text(const std::vector<std::pair<std::string, double>>& fractions, const char* separator = ", ") {
+  std::string text;
+  for (const auto& [name, f] : fractions) text += (text.empty() ? "" : separator) + name + format(" %.3g", 100.0 * f);
+  return text;
+}
+
+std::string describe_failure(const FailureTestResult& r) {
+  return format("sigma_fail = %.4g GPa", r.peak_stress * 1e-9) + format(" at strain %.4g", r.strain_at_peak) +
+         format(", secant E %.4g GPa", r.secant_modulus * 1e-9) + (r.broke ? ", broke" : ", did not break") +
+         "; broken % at the peak: " + broken_text(r.broken_at_peak) + "; at the end: " + broken_text(r.broken_at_end) + ", " +
+         std::to_string(r.particles) + " DEs, " + std::to_string(r.steps) + " steps" + format(", wall %.1f s", r.wall_seconds);
+}
+
+int run_failure_suite(const std::filesystem::path& case_file, const SceneOptions& options, const std::filesystem::path& out_dir,
+                      const std::vector<SampleVariant>& samples, const std::vector<std::string>& only_samples,
+                      const std::vector<LoadCase>& tests, const std::vector<std::optional<FailureReference>>& references,
+                      const FailurePlan& plan) {
+  std::printf("tests to failure of %s: %s\n", case_file.string().c_str(), plan.describe().c_str());
+  std::string csv = "sample,test,load,particles,bonds,steps,dt,transit_time,velocity,failure_stress,failure_strain,secant_modulus,"
+                    "final_stress,final_strain,broke,breaks,fracture_energy,broken_at_peak,broken_at_end,wall_seconds,status\n";
+  std::string md = "| sample | test | DEs | sigma_fail GPa | eps_fail 1e-3 | secant E GPa | broken % at the peak | broken % at the end | wall s |\n"
+                   "|---|---|---|---|---|---|---|---|---|\n";
+  int stopped = 0;
+  for (const SampleVariant& sample : samples) {
+    if (!only_samples.empty() && std::find(only_samples.begin(), only_samples.end(), sample.name) == only_samples.end()) continue;
+    for (std::size_t t = 0; t < tests.size(); ++t) {
+      const LoadCase& load = tests[t];
+      SceneOptions test_options = options;
+      test_options.overrides.insert(test_options.overrides.end(), sample.overrides.begin(), sample.overrides.end());
+      test_options.out_dir = out_dir / sample.name / load.name;
+      try {
+        const FailureTestResult r = run_failure_test(case_file, test_options, load, plan);
+        std::printf("%s %s: %s\n", sample.name.c_str(), load.name.c_str(), describe_failure(r).c_str());
+        csv += sample.name + "," + load.name + "," + load.describe() + "," + std::to_string(r.particles) + "," +
+               std::to_string(r.bonds) + "," + std::to_string(r.steps);
+        for (double v : {r.dt, r.transit_time, r.velocity, r.peak_stress, r.strain_at_peak, r.secant_modulus, r.final_stress,
+                         r.final_strain})
+          csv += format(",%.9g", v);
+        csv += std::string(",") + (r.broke ? "1" : "0") + "," + std::to_string(r.breaks) + format(",%.9g", r.fracture_energy) + "," +
+               broken_text(r.broken_at_peak, "; ") + "," + broken_text(r.broken_at_end, "; ") + format(",%.1f", r.wall_seconds) + ",ok\n";
+        md += "| " + sample.name + " | " + load.name + " | " + std::to_string(r.particles) + " | " + format("%.3f", r.peak_stress * 1e-9) +
+              " | " + format("%.2f", r.strain_at_peak * 1e3) + " | " + format("%.4g", r.secant_modulus * 1e-9) + " | " +
+              broken_text(r.broken_at_peak) + " | " + broken_text(r.broken_at_end) + " | " + format("%.0f", r.wall_seconds) + " |\n";
+      } catch (const RunError& e) {
+        ++stopped;
+        std::printf("%s %s: stopped: %s\n", sample.name.c_str(), load.name.c_str(), e.what());
+        csv += sample.name + "," + load.name + "," + load.describe() + std::string(18, ',') + "stopped\n";
+        md += "| " + sample.name + " | " + load.name + " | stopped: " + e.what() + " | | | | | | |\n";
+      }
+      if (const auto& ref = references[t]) {
+        std::string broken;
+        for (const auto& [name, range] : ref->broken)
+          broken += (broken.empty() ? "" : ", ") + name + format(" %.3g", range[0]) + format("-%.3g", range[1]);
+        md += "| " + ref->name + " | " + load.name + " | | " + format("%.2f", ref->stress[0] * 1e-9) + format("-%.2f", ref->stress[1] * 1e-9) +
+              " | " + format("%.2f", ref->strain[0] * 1e3) + format("-%.2f", ref->strain[1] * 1e3) + " | | | " + broken + " | |\n";
+      }
+      std::fflush(stdout);
+      write_file_atomically(out_dir / "failure.csv", csv);
+      write_file_atomically(out_dir / "failure.md", md);
+    }
+  }
+  std::printf("\n%s", md.c_str());
+  return stopped;
 }
 
 }  // namespace
@@ -524,10 +813,22 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
     if (std::none_of(samples.begin(), samples.end(), [&](const SampleVariant& s) { return s.name == name; }))
       throw InputError(spec_file.string() + ": no sample named '" + name + "'");
   const QuasiStatic plan = QuasiStatic::read(root.child_if("quasi_static"));
+  const std::optional<CaseNode> failure_node = root.child_if("failure");
   std::vector<LoadCase> tests;
+  std::vector<std::optional<FailureReference>> references;
   for (CaseNode t : root.list("tests")) {
     tests.push_back(LoadCase::read(t));
+    if (failure_node) {
+      if (tests.back().shear()) t.fail("shear", "a test to failure (failure section) is a tension test");
+      references.push_back(FailureReference::read(t.child_if("reference")));
+    }
     t.finish();
+  }
+  if (failure_node) {
+    if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
+    const FailurePlan failure = FailurePlan::read(failure_node, FailurePlan{});
+    root.finish();
+    return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, failure);
   }
   std::optional<CompositeSpec> composite;
   std::optional<CompositeTests> roles;

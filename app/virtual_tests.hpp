@@ -63,11 +63,12 @@ struct LoadCase {
   int face = 2;       // the loaded faces are normal to this axis
   int direction = 2;  // the upper face moves along this axis
   std::optional<double> modulus_estimate;  // Pa, for the time scale; none: affine estimate
+  std::vector<std::string> overrides;      // the test's own `set: [key=value, ...]`, after the sample's
 
   bool shear() const { return face != direction; }
   std::string describe() const;  // "tension along z", "shear of the z faces along x"
-  // Reads {name, tension: z} or {name, shear: [z, x]} (faces, then direction) and an optional
-  // modulus_estimate [Pa]; InputError at the key otherwise.
+  // Reads {name, tension: z} or {name, shear: [z, x]} (faces, then direction), an optional
+  // modulus_estimate [Pa] and set; InputError at the key otherwise.
   static LoadCase read(CaseNode& node);
 };
 
@@ -105,6 +106,55 @@ struct VirtualTestResult {
   std::filesystem::path out_dir;
 };
 
+// A tension test to failure (seed Table 4, Figs. 5-6): the upper face driven at a constant
+// velocity along the axis, the lower face held, both in that component only (rollers); the
+// velocity grows smoothly over `rise` transits (no step, so no ringing), then stays constant,
+// the rate set so that the strain reaches expected_strain after `transits` transit times
+// (same T as above). Damping is light: mass-proportional damping of a sample stretched at a
+// constant rate makes the stress differ between the faces by about pi zeta E (strain per
+// transit); zeta 0.05 and 4e-4 per transit keep that below 1 % of a failure stress at a
+// strain of 1e-2. The run ends when the stress on the moved face has fallen below
+// stop_below of its peak (past 0.2 expected_strain), or at max_strain_factor expected_strain.
+// Failure stress = peak of F_moved / area; failure strain = the gauge strain at that row.
+struct FailurePlan {
+  double expected_strain = 1.0e-2;
+  double transits = 25.0;
+  double max_strain_factor = 2.0;
+  double stop_below = 0.5;
+  double damping = 0.05;
+  double rise = 1.0;             // transit times
+  double rows_per_transit = 20.0;
+  int frames = 0;                // HDF5/XDMF frames of particles and bonds over the run (0: none)
+
+  // Reads an optional mapping with the fields above over `defaults`.
+  static FailurePlan read(std::optional<CaseNode> node, const FailurePlan& defaults);
+  std::string describe() const;
+};
+
+struct FailureTestResult {
+  LoadCase load;
+  double peak_stress = 0.0;      // Pa, sigma_fail
+  double strain_at_peak = 0.0;   // eps_fail
+  double secant_modulus = 0.0;   // Pa, stress / strain where the stress first reaches half its peak
+  double final_stress = 0.0, final_strain = 0.0;
+  bool broke = false;            // the stress fell below stop_below of its peak
+  std::vector<std::pair<std::string, double>> broken_at_peak, broken_at_end;  // bond set, fraction
+  std::size_t breaks = 0;
+  double fracture_energy = 0.0;  // J, energy of the broken bonds
+  double transit_time = 0.0, damping = 0.0, velocity = 0.0;  // s, 1/s, m/s
+  std::size_t particles = 0, bonds = 0;
+  long steps = 0;
+  double dt = 0.0;
+  double wall_seconds = 0.0;
+  std::filesystem::path out_dir;
+};
+
+// Runs one tension test to failure into options.out_dir (required); writes test.json and
+// failure.png (stress and broken fractions per bond set against strain) next to the run's
+// outputs. InputError for a shear load case or a case without failure criteria.
+FailureTestResult run_failure_test(const std::filesystem::path& case_file, const SceneOptions& options,
+                                   const LoadCase& load, const FailurePlan& plan);
+
 // Runs one test of the sample case into options.out_dir (required) and measures it; options'
 // overrides apply to the case before the test's own. Writes test.json next to the run's
 // outputs. InputError if the case is not a DEM case or the load case is bad; RunError if the
@@ -116,7 +166,12 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
 //   case: case.yaml                  the sample case (relative to the spec file)
 //   samples: [{name, set: ["key=value", ...]}]   variants of the case (default: one, "base")
 //   quasi_static: {...}              QuasiStatic
-//   tests: [{name, tension: z | shear: [z, x], modulus_estimate}]
+//   tests: [{name, tension: z | shear: [z, x], modulus_estimate, set: ["key=value", ...]}]
+//   failure: {...}                   optional FailurePlan: every test (tension only) runs to
+//                                    failure instead; each test may carry
+//     reference: {name, stress: [lo, hi] Pa, strain: [lo, hi], broken: {<bond set>: [lo, hi] %}}
+//                                    (e.g. the range of seed Table 4) for the table
+//                                    out_dir/failure.md; out_dir/failure.csv has every run
 //   composite:                       optional: a unidirectional composite whose tests are named
 //     fibre: {E, nu}, matrix: {E, nu}, fibre_fraction     L (tension along the fibres), T
 //     references: [{name, E_L, E_T, nu_LT, nu_TT, G_LT, G_TT}]  (tension across), LT (shear

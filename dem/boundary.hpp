@@ -1,7 +1,8 @@
 // Boundary conditions on groups of DEs, applied from t = 0.
 //
 //   fixed         x = x_ref, v = 0, rotation locked (clamped)
-//   velocity      v = value (m/s); x = x_ref + value t
+//   velocity      v = value (m/s); x = x_ref + value t; with a rise time (s) the velocity grows
+//                 as value (1 - cos(pi t / rise)) / 2 first (no step: no ringing), x its integral
 //   displacement  linear ramp to value (m) over ramp (s), then held: v = value/ramp, then 0
 //   force         total force value (N) shared equally by the group's DEs (a dead load)
 //   free          nothing imposed; declares that the group must not be constrained
@@ -29,6 +30,7 @@ struct BoundaryCondition {
   double ramp = 0.0;        // s, displacement only
   bool lock_rotation = false;
   std::array<bool, 3> components{true, true, true};  // kinematic: which translations are imposed
+  double rise = 0.0;        // s, velocity only
 
   bool kinematic() const {
     return kind == BoundaryKind::fixed || kind == BoundaryKind::velocity || kind == BoundaryKind::displacement;

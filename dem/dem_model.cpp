@@ -102,6 +102,15 @@ void DemModel::finalize() {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
+  if (rdef_) {
+    rdef_threshold_.assign(particles.size(), rdef_->threshold);
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      for (const auto& [group, threshold] : rdef_->group_thresholds)
+        if (particles.groups[i] & (GroupMask{1} << group)) {
+          rdef_threshold_[i] = threshold;
+          break;
+        }
+  }
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
   compute_forces();
@@ -248,7 +257,7 @@ void DemModel::apply_failures() {
     std::vector<double> equivalent(p.size(), 0.0);
     for (std::size_t i = 0; i < p.size(); ++i) {
       equivalent[i] = rdef_->von_mises ? von_mises(sigma[i]) : max_principal(sigma[i]);
-      failed[i] = equivalent[i] >= rdef_->threshold;
+      failed[i] = equivalent[i] >= rdef_threshold_[i];
     }
     for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
       const BondSet& set = *bond_sets_[s];

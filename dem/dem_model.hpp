@@ -64,11 +64,14 @@ class DemModel {
   void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
 
   // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
-  // stress reaches `threshold`; Omega_i = sphere volume / compaction.
+  // stress reaches the DE's threshold; Omega_i = sphere volume / compaction. A DE in one of
+  // the listed groups takes that group's threshold (the first listed that holds it), any
+  // other DE `threshold` (infinite: such DEs never fail by RDEF).
   struct RdefSettings {
     double threshold = 0.0;   // Pa
     bool von_mises = false;   // else the maximal principal stress
     double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
+    std::vector<std::pair<int, double>> group_thresholds;  // (group index, Pa), e.g. per material
   };
   void enable_rdef(const RdefSettings& settings) { rdef_ = settings; }
 
@@ -139,6 +142,7 @@ class DemModel {
   std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
   std::optional<RdefSettings> rdef_;
+  std::vector<double> rdef_threshold_;  // Pa, per DE (finalize)
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "app/scene.hpp"
+#include "common/error.hpp"
 #include "support/cli.hpp"
 
 namespace arlequin {
@@ -47,6 +48,29 @@ TEST(Materials, ASecondMaterialWithoutRegionIsRefused) {
   const auto r = test::run_arlequin("check " + (dir / "case.yaml").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("only one material may go without a region"), std::string::npos) << r.output;
+}
+
+// RDEF thresholds per material: every material named once, or a default threshold for the rest.
+TEST(Materials, RdefThresholdsPerMaterial) {
+  const auto build = [](const std::string& rdef) {
+    app::SceneOptions options;
+    options.overrides = {"dem.failure.rdef=" + rdef};
+    return app::build_scene(data + "two_materials.yaml", options);
+  };
+  EXPECT_TRUE(build("{material_thresholds: {fibre: 5.0e9, matrix: 1.5e8}}").dem.failure_enabled());
+  EXPECT_NO_THROW(build("{threshold: 1.0e8, material_thresholds: {fibre: 5.0e9}}"));
+  const auto error = [&](const std::string& rdef) {
+    try {
+      build(rdef);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("{material_thresholds: {fiber: 5.0e9, matrix: 1.5e8}}").find("fiber: no material of that name"), std::string::npos);
+  EXPECT_NE(error("{material_thresholds: {fibre: 5.0e9}}").find("without their own: matrix"), std::string::npos);
+  EXPECT_NE(error("{threshold: 1.0e8, material_thresholds: {fibre: 5.0e9, matrix: 1.5e8}}").find("every material has its own"),
+            std::string::npos);
 }
 
 }  // namespace

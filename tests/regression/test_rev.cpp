@@ -143,6 +143,99 @@ TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   EXPECT_EQ(again.at("r_mu").as_number(), r_mu);
 }
 
+// Failure calibration (issue: REV failure): BBF and RDEF strengths of the epoxy pair reproduce
+// its tensile failure stress on the small packing within the tolerance (3 %), from the seed's
+// values as first guesses; the rounds' stress follows the threshold about proportionally (the
+// premise of the update), and a BBF case is refused for an RDEF target.
+TEST(Calibration, StrengthsReproduceTheTargetFailureStress) {
+  const auto dir = test::scratch_dir("calibration_strength");
+  homogeneous_case(dir);
+  const std::string targets =
+      "    - {name: epoxy, criterion: bbf, stress: 7.0e7, E: 3.45e9, E_mu: 1.1527e11, r_mu: 0.2872, reference: 2.0e9}\n"
+      "    - {name: epoxy, criterion: rdef, stress: 7.0e7, E: 3.45e9, E_mu: 1.1527e11, r_mu: 0.2872, reference: 1.48e8}\n";
+  write(dir / "strength.yaml", "case: sample.yaml\nfailure:\n  tolerance: 0.03\n  targets:\n" + targets);
+  const auto r = test::run_arlequin("calibrate " + (dir / "strength.yaml").string() + " --out " + (dir / "out").string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"strength.csv", "calibration.md", "calibration.json"}) EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
+  const Json strengths = Json::parse(test::read_text(dir / "out" / "calibration.json")).at("strengths");
+  ASSERT_EQ(strengths.as_array().size(), 2u);
+  for (const Json& s : strengths.as_array()) {
+    EXPECT_TRUE(s.at("converged").as_bool());
+    EXPECT_NEAR(s.at("failure_stress").as_number(), 7.0e7, 0.05 * 7.0e7) << s.at("criterion").as_string();
+  }
+  // Every round: stress / threshold within 25 % of the first round's (near proportionality).
+  const auto rounds = read_csv(dir / "out" / "strength.csv");
+  ASSERT_GE(rounds.size(), 3u);  // each criterion needed at least one update from the seed's value
+  std::map<std::string, double> first;
+  for (const auto& row : rounds) {
+    const double ratio = number(row, "failure_stress") / number(row, "threshold");
+    if (!first.count(row.at("criterion"))) first[row.at("criterion")] = ratio;
+    EXPECT_NEAR(ratio / first[row.at("criterion")], 1.0, 0.25) << row.at("criterion") << " round " << row.at("round");
+  }
+
+  std::string bbf = test::read_text(dir / "sample.yaml");
+  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
+  write(dir / "bbf_case.yaml", bbf);
+  write(dir / "bad.yaml", "case: bbf_case.yaml\nfailure:\n  targets:\n" + targets.substr(targets.find("    - {name: epoxy, criterion: rdef")));
+  const auto bad = test::run_arlequin("calibrate " + (dir / "bad.yaml").string() + " --out " + (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("needs a case without one"), std::string::npos) << bad.output;
+}
+
+// A composite cube to failure, BBF and RDEF: the suite writes its table with the reference row,
+// each run breaks with a peak stress, failure strain, broken fractions per bond set and the
+// plot of seed Figs. 5-6; the energy of the broken bonds is in the balance.
+TEST(VirtualTests, CompositeToFailureReportsStressStrainAndBrokenBonds) {
+  const auto dir = test::scratch_dir("virtual_tests_failure");
+  write(dir / "composite.yaml",
+        "name: composite\n"
+        "time: {end: 1.0e-6}\n"
+        "dem:\n"
+        "  sample: {build: packing, region: {box: [[0, 0, 0], [1.6e-3, 1.6e-3, 1.6e-3]]}, radius: {mean: 6.0e-5, std: 0.25},\n"
+        "           seed: 3, file: sample.h5}\n"
+        "  materials:\n"
+        "    fibre: {region: {cylinder: {base: [8.0e-4, 8.0e-4, 0], axis: [0, 0, 1], radius: 6.46e-4}}, density: 1750,\n"
+        "            bond: {law: beam, E_mu: 8.687e12, nu_mu: 0.3, r_mu: 0.2872}}\n"
+        "    matrix: {density: 1200, bond: {law: beam, E_mu: 1.1527e11, nu_mu: 0.3, r_mu: 0.2872}}\n"
+        "  interface: {bond: {law: beam, E_mu: 1.1527e11, nu_mu: 0.3, r_mu: 0.2872}}\n");
+  write(dir / "spec.yaml",
+        "case: composite.yaml\n"
+        "failure: {expected_strain: 9.6e-3, transits: 15, frames: 4}\n"
+        "tests:\n"
+        "  - {name: bbf, tension: z, modulus_estimate: 9.52e9,\n"
+        "     set: [dem.materials.fibre.bond.sigma_f=2.1e11, dem.materials.matrix.bond.sigma_f=2.0e9, dem.interface.bond.sigma_f=2.0e9],\n"
+        "     reference: {name: seed Table 4, stress: [1.30e9, 1.42e9], strain: [8.86e-3, 10.0e-3],\n"
+        "                 broken: {fibre: [3.7, 4.6], matrix: [40, 48], interface: [91, 99]}}}\n"
+        "  - {name: rdef, tension: z, modulus_estimate: 9.52e9,\n"
+        "     set: [\"dem.failure.rdef={material_thresholds: {fibre: 8.8e9, matrix: 1.5e8}}\"]}\n");
+  const auto r = test::run_arlequin("virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string md = test::read_text(dir / "out" / "failure.md");
+  EXPECT_NE(md.find("| seed Table 4 | bbf | | 1.30-1.42 | 8.86-10.00 |"), std::string::npos) << md;
+  const auto rows = read_csv(dir / "out" / "failure.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    const std::string test = row.at("test");
+    // BBF breaks abruptly (the stress falls below half its peak); RDEF softens more gradually.
+    if (test == "bbf") {
+      EXPECT_EQ(row.at("broke"), "1");
+    }
+    EXPECT_LT(number(row, "final_stress"), 0.9 * number(row, "failure_stress")) << test;
+    // The fibre carries the load: failure near the fibre's strain, at a stress near the rule of mixtures.
+    EXPECT_GT(number(row, "failure_strain"), 5e-3) << test;
+    EXPECT_LT(number(row, "failure_strain"), 1.5e-2) << test;
+    // Fibre fraction pi 0.646^2 / 1.6^2 = 0.51: half the rule of mixtures' 1.28 GPa at least.
+    EXPECT_GT(number(row, "failure_stress"), 0.5 * 0.51 * 2.5e9) << test;
+    EXPECT_GT(number(row, "fracture_energy"), 0.0) << test;
+    const Json j = Json::parse(test::read_text(dir / "out" / "base" / test / "test.json"));
+    for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GE(j.at("broken_at_end").at(set).as_number(), 0.0) << set;
+    EXPECT_GT(j.at("broken_at_end").at("fibre").as_number(), j.at("broken_at_peak").at("fibre").as_number()) << test;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "base" / test / "failure.png")) << test;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "base" / test / "fields.xdmf")) << test;
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / "base" / test / "breaks.csv")) << test;
+  }
+}
+
 TEST(VirtualTests, CompositeSpecNeedsItsFourTests) {
   const auto dir = test::scratch_dir("virtual_tests_bad_spec");
   homogeneous_case(dir);
@@ -216,6 +309,27 @@ TEST(ValidationRev, CalibrationReproducesTable1Materials) {
     EXPECT_NEAR(bond.number("E_mu", Range::positive(), "Pa"), pair.at("E_mu").as_number(), 0.01 * pair.at("E_mu").as_number());
     EXPECT_NEAR(bond.number("r_mu", Range::positive(), "1"), pair.at("r_mu").as_number(), 0.001);
   }
+}
+
+// R4 on the 40k-DE REV, longitudinal tension to failure: sigma_fail 1.30-1.50 GPa and eps_fail
+// (9.6 +- 1.0)e-3 for both criteria, RDEF failing at a larger strain than BBF.
+TEST(ValidationRev, Rev40kFailureMatchesSeedTable4) {
+  const auto dir = test::scratch_dir("rev_40k_failure");
+  const auto r = test::run_arlequin("virtual-test " + (std::filesystem::path(ARLEQUIN_SOURCE_DIR) / "cases" / "rev_failure" /
+                                                       "failure_tests.yaml").string() +
+                                        " --sample rev_40k --out " + dir.string(),
+                                    "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::map<std::string, std::map<std::string, std::string>> by_test;
+  for (const auto& row : read_csv(dir / "failure.csv")) by_test[row.at("test")] = row;
+  for (const char* test : {"L_bbf", "L_rdef"}) {
+    const auto& row = by_test.at(test);
+    EXPECT_EQ(row.at("status"), "ok") << test;
+    EXPECT_GE(number(row, "failure_stress"), 1.30e9) << test;
+    EXPECT_LE(number(row, "failure_stress"), 1.50e9) << test;
+    EXPECT_NEAR(number(row, "failure_strain"), 9.6e-3, 1.0e-3) << test;
+  }
+  EXPECT_GT(number(by_test.at("L_rdef"), "failure_strain"), number(by_test.at("L_bbf"), "failure_strain"));
 }
 
 // R3 on the 40k-DE REV: E_L within -5 % / +15 % of 135.06 GPa, nu_LT 0.29 +- 0.02, E_T, G_LT and

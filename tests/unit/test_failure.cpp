@@ -109,7 +109,7 @@ TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
   test::bond_all_touching(model, {2e11, 0.3, 0.5});
   // DE 2 carries 2.36e7 Pa (both bonds stretched 1e-6 m), DEs 1 and 3 half of it.
-  model.enable_rdef({1.8e7, false, 0.63});
+  model.enable_rdef({1.8e7, false, 0.63, {}});
   model.finalize();
   // Stretch the middle DE's two bonds only: move DEs 3 and 4 right, 0 and 1 left.
   for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
@@ -125,6 +125,32 @@ TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
   }
   EXPECT_NEAR(model.damage()[2], 1.0, 0.0);
   EXPECT_NEAR(model.energies().fracture, stored, 1e-6 * stored);
+}
+
+// Per-group thresholds (one per material in a composite): the same loading as above, DE 2
+// (2.36e7 Pa) below its group's threshold, DE 1 (1.18e7 Pa) above its group's, DE 3
+// (1.18e7 Pa) in no listed group and under the default threshold: only DE 1's bonds break.
+TEST(Rdef, EachGroupFailsAtItsOwnThreshold) {
+  DemModel model;
+  const double R = 1e-3;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
+  test::bond_all_touching(model, {2e11, 0.3, 0.5});
+  const int hub = model.add_group("hub"), side = model.add_group("side");
+  model.particles.groups[2] |= GroupMask{1} << hub;
+  model.particles.groups[1] |= GroupMask{1} << side;
+  DemModel::RdefSettings settings{1.5e7, false, 0.63, {}};
+  settings.group_thresholds = {{hub, 3.0e7}, {side, 1.0e7}};
+  model.enable_rdef(settings);
+  model.finalize();
+  for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
+  for (std::size_t i : {3u, 4u}) model.particles.position[i].x += 1e-6;
+  model.step(1e-12);
+  ASSERT_EQ(model.breaks().size(), 2u);
+  for (const auto& e : model.breaks()) {
+    const auto& set = *model.bond_sets()[e.set];
+    EXPECT_TRUE(set.first()[e.bond] == 1 || set.second()[e.bond] == 1);
+  }
+  EXPECT_EQ(model.damage()[3], 0.0);
 }
 
 // Two DEs bonded by a weak beam are pulled apart until it breaks; sent back towards each other,
