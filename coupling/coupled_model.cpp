@@ -71,12 +71,9 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_);
 
   // Initial velocities onto the constraint.
-  Matrix3 dd, dc;
-  {
-    Matrix3 vd = gather_dem_velocity();
-    solver_->project(vd, continuum_velocity(), dd, dc);
-    scatter_dem_velocity(vd);
-  }
+  gather_dem_velocity(vd_);
+  solver_->project(vd_, continuum_velocity(), dd_, dc_, lambda_);
+  scatter_dem_velocity(vd_);
   // Constraint force at t = 0: the projection of the unconstrained accelerations.
   Matrix3 ad(np, 3);
   for (int p = 0; p < np; ++p) {
@@ -85,8 +82,10 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   }
   Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
       Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
-  mu_ = solver_->project(ad, ac, acc_d_, acc_c_);
-  update_monitor(solver_->residual(gather_dem_velocity(), continuum_velocity()));
+  solver_->project(ad, ac, acc_d_, acc_c_, mu_);
+  gather_dem_velocity(vd_);
+  solver_->residual(vd_, continuum_velocity(), residual_);
+  update_monitor(residual_);
   acceleration_norm_ = acceleration_norm();
 
   time_steps_.dem = dem_.critical_time_step();
@@ -112,13 +111,12 @@ std::string CoupledModel::summary() const {
   return s.str();
 }
 
-Matrix3 CoupledModel::gather_dem_velocity() const {
-  Matrix3 v(ops_.num_particles(), 3);
+void CoupledModel::gather_dem_velocity(Matrix3& v) const {
+  v.resize(ops_.num_particles(), 3);
   for (int p = 0; p < ops_.num_particles(); ++p) {
     const Vec3& u = dem_.particles.velocity[ops_.particles[p]];
     v.row(p) << u.x, u.y, u.z;
   }
-  return v;
 }
 
 void CoupledModel::scatter_dem_velocity(const Matrix3& v) {
@@ -151,7 +149,8 @@ void CoupledModel::advance_models(double dt) {
   continuum_.kick(0.5 * dt);
   continuum_.drift(dt);
   continuum_.compute_forces();
-  drift_residual_ = solver_->residual(gather_dem_velocity(), continuum_velocity());
+  gather_dem_velocity(vd_);
+  solver_->residual(vd_, continuum_velocity(), drift_residual_);
 }
 
 void CoupledModel::kick_to_trial(double dt) {
@@ -160,22 +159,24 @@ void CoupledModel::kick_to_trial(double dt) {
 }
 
 void CoupledModel::solve_and_correct(double dt) {
-  Matrix3 vd = gather_dem_velocity();
-  const Matrix3 lambda = solver_->project(vd, continuum_velocity(), acc_d_, acc_c_);
-  scatter_dem_velocity(vd);
+  gather_dem_velocity(vd_);
+  solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_);
+  scatter_dem_velocity(vd_);
   const double h = 0.5 * dt;
   acc_d_ /= h;
   acc_c_ /= h;
-  const Matrix3 mu = lambda / h;
+  lambda_ /= h;  // now mu(n+1)
   // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2).
-  coupling_work_ -= dt * (0.5 * (mu_ + mu)).cwiseProduct(drift_residual_).sum();
-  mu_ = mu;
+  coupling_work_ -= 0.5 * dt * ((mu_ + lambda_).cwiseProduct(drift_residual_)).sum();
+  mu_.swap(lambda_);
 }
 
 void CoupledModel::account_energy(double) {
   acceleration_norm_ = acceleration_norm();
-  update_monitor(solver_->residual(gather_dem_velocity(), continuum_velocity()));
-  const double scale = frobenius(ops_.Gd * gather_dem_velocity());
+  gather_dem_velocity(vd_);
+  solver_->residual(vd_, continuum_velocity(), residual_);
+  update_monitor(residual_);
+  const double scale = monitor_scale_;
   monitor_.drift_residual = scale > 0 ? frobenius(drift_residual_) / scale : frobenius(drift_residual_);
 }
 
@@ -203,13 +204,23 @@ std::array<double, 2> CoupledModel::acceleration_norm() const {
 }
 
 void CoupledModel::update_monitor(const Matrix3& residual_after) {
-  const Matrix3 vd = gather_dem_velocity();
-  const double scale = frobenius(ops_.Gd * vd);
+  // |G_d vd|, the scale of both residuals (dd_ is free scratch here).
+  dd_.resize(ops_.rows(), 3);
+  dd_.noalias() = ops_.Gd * vd_;
+  monitor_scale_ = frobenius(dd_);
+  const double scale = monitor_scale_;
   monitor_.constraint_residual = scale > 0 ? frobenius(residual_after) / scale : frobenius(residual_after);
-  const Matrix3 mismatch = vd - ops_.N * Eigen::Map<const Matrix3>(continuum_.velocity().data(), continuum_.num_nodes(), 3);
-  const Eigen::VectorXd per = mismatch.rowwise().norm();
-  monitor_.velocity_mismatch = per.size() ? std::sqrt(per.squaredNorm() / per.size()) : 0.0;
-  monitor_.max_velocity_mismatch = per.size() ? per.maxCoeff() : 0.0;
+  mismatch_.noalias() = ops_.N * Eigen::Map<const Matrix3>(continuum_.velocity().data(), continuum_.num_nodes(), 3);
+  mismatch_ -= vd_;
+  const Eigen::Index n = mismatch_.rows();
+  double sum = 0.0, largest = 0.0;
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const double m2 = mismatch_.row(p).squaredNorm();
+    sum += m2;
+    largest = std::max(largest, m2);
+  }
+  monitor_.velocity_mismatch = n ? std::sqrt(sum / double(n)) : 0.0;
+  monitor_.max_velocity_mismatch = std::sqrt(largest);
 }
 
 CoupledEnergies CoupledModel::energies() const {
@@ -232,7 +243,9 @@ double CoupledModel::displacement_residual() const {
   }
   const Eigen::Map<const Matrix3> uc(continuum_.displacement().data(), continuum_.num_nodes(), 3);
   const double scale = frobenius(ops_.Gd * ud);
-  const double r = frobenius(solver_->residual(ud, uc));
+  Matrix3 r_matrix;
+  solver_->residual(ud, uc, r_matrix);
+  const double r = frobenius(r_matrix);
   return scale > 0 ? r / scale : r;
 }
 

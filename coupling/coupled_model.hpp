@@ -130,10 +130,10 @@ class CoupledModel {
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
   void account_energy(double dt);
 
-  Matrix3 gather_dem_velocity() const;
+  void gather_dem_velocity(Matrix3& v) const;
   void scatter_dem_velocity(const Matrix3& v);
   Eigen::Map<Matrix3> continuum_velocity();
-  void update_monitor(const Matrix3& residual_after);
+  void update_monitor(const Matrix3& residual_after);  // uses vd_ (the coupled DEs' velocities)
 
   dem::DemModel& dem_;
   continuum::ContinuumSolver& continuum_;
@@ -145,6 +145,10 @@ class CoupledModel {
   Matrix3 acc_d_, acc_c_;  // constraint accelerations M^-1 G^T mu(n) (subtracted)
   Matrix3 mu_;             // multipliers of the constraint force at t(n)
   Matrix3 drift_residual_;
+  // Scratch of the step (sized once; no allocation per step): coupled DE velocities,
+  // multipliers, residual, corrections, velocity mismatch.
+  Matrix3 vd_, lambda_, residual_, dd_, dc_, mismatch_;
+  double monitor_scale_ = 0.0;  // |G_d vd| at the last monitor update
   TimeSteps time_steps_;
   CouplingMonitor monitor_;
   bool continuum_stiffness_floored_ = false;

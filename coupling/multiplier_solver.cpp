@@ -43,27 +43,40 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
                      "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, "
                      "or mediator: fine)");
     factor_of_[c] = static_cast<int>(factors_.size());
+    diagonals_.push_back(f->vectorD());
     factors_.push_back(std::move(f));
   }
 }
 
-Matrix3 MultiplierSolver::solve(const Matrix3& rhs) const {
-  Matrix3 lambda(rhs.rows(), 3);
-  for (int c = 0; c < 3; ++c) lambda.col(c) = factors_[factor_of_[c]]->solve(Eigen::VectorXd(rhs.col(c)));
-  return lambda;
+// The factor's solve spelled out, P^T L D L^T P lambda = rhs: Eigen's own applies the inverse
+// permutation in place, which allocates a mask each call.
+void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
+  lambda.resize(rhs.rows(), 3);
+  for (int c = 0; c < 3; ++c) {
+    const Factor& f = *factors_[factor_of_[c]];
+    column_ = rhs.col(c);
+    solution_ = f.permutationP() * column_;
+    f.matrixL().solveInPlace(solution_);
+    solution_.array() /= diagonals_[factor_of_[c]].array();
+    f.matrixU().solveInPlace(solution_);
+    lambda.col(c) = f.permutationPinv() * solution_;
+  }
 }
 
-Matrix3 MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc) const {
-  return ops_->Gd * vd + ops_->Gc * vc;
+void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const {
+  out.noalias() = ops_->Gd * vd;
+  out.noalias() += ops_->Gc * vc;
 }
 
-Matrix3 MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc) const {
-  const Matrix3 lambda = solve(residual(vd, vc));
-  dd = inv_d_.cwiseProduct(Matrix3(ops_->Gd.transpose() * lambda));
-  dc = inv_c_.cwiseProduct(Matrix3(ops_->Gc.transpose() * lambda));
+void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
+  residual(vd, vc, rhs_);
+  solve(rhs_, lambda);
+  dd.noalias() = ops_->Gd.transpose() * lambda;
+  dd.array() *= inv_d_.array();
+  dc.noalias() = ops_->Gc.transpose() * lambda;
+  dc.array() *= inv_c_.array();
   vd -= dd;
   vc -= dc;
-  return lambda;
 }
 
 }  // namespace arlequin::coupling

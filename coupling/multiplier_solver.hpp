@@ -12,6 +12,9 @@
 //    the M-orthogonal projection onto ker G (after it G_d vd + G_c vc = 0 to round-off).
 //    vd: coupled DEs x 3 (order of CouplingOperators::particles); vc: continuum nodes x 3.
 //    The corrections (M^-1 G^T lambda) are returned in dd, dc.
+//  - No allocation per call once the outputs have their sizes (rows x 3, DEs x 3, nodes x 3):
+//    the explicit step calls these every step; scratch lives in the solver (one solver per
+//    coupled model, not shared between threads).
 //  - RunError if A is not positive definite (e.g. a coarse mediator with too few DEs per
 //    element to fix every mediator node; the message suggests the fine mediator).
 #pragma once
@@ -33,12 +36,12 @@ class MultiplierSolver {
   MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
                    const std::vector<double>& inv_mass_c);
 
-  // A lambda = rhs per component (rhs: rows x 3).
-  Matrix3 solve(const Matrix3& rhs) const;
-  // G_d vd + G_c vc (rows x 3).
-  Matrix3 residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc) const;
-  // Projects (vd, vc) onto ker G; returns lambda and the corrections M^-1 G^T lambda.
-  Matrix3 project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc) const;
+  // A lambda = rhs per component (rhs, lambda: rows x 3).
+  void solve(const Matrix3& rhs, Matrix3& lambda) const;
+  // out = G_d vd + G_c vc (rows x 3).
+  void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
+  // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
+  void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
   int factorizations() const { return static_cast<int>(factors_.size()); }
   int rows() const { return ops_->rows(); }
@@ -49,8 +52,11 @@ class MultiplierSolver {
   const CouplingOperators* ops_;
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
   std::vector<std::unique_ptr<Factor>> factors_;
+  std::vector<Eigen::VectorXd> diagonals_;     // D of each factor
   std::array<int, 3> factor_of_{0, 0, 0};      // component -> factor
   long nonzeros_ = 0;
+  mutable Matrix3 rhs_;                        // scratch: the residual to project
+  mutable Eigen::VectorXd column_, solution_;  // scratch: one component
 };
 
 }  // namespace arlequin::coupling

@@ -252,21 +252,20 @@ void DemModel::apply_failures() {
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) {
     const ParticleSet& p = particles;
-    const std::vector<Sym3> sigma = virial_stress(rdef_->compaction);
-    std::vector<char> failed(p.size(), 0);
-    std::vector<double> equivalent(p.size(), 0.0);
+    virial_stress(rdef_->compaction, rdef_stress_);
+    rdef_equivalent_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
-      equivalent[i] = rdef_->von_mises ? von_mises(sigma[i]) : max_principal(sigma[i]);
-      failed[i] = equivalent[i] >= rdef_threshold_[i];
+      const double equivalent = rdef_->von_mises ? von_mises(rdef_stress_[i]) : max_principal(rdef_stress_[i]);
+      rdef_equivalent_[i] = equivalent >= rdef_threshold_[i] ? equivalent : -1.0;  // -1: the DE holds
     }
     for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
       const BondSet& set = *bond_sets_[s];
       for (std::size_t b = 0; b < set.size(); ++b) {
         const std::uint32_t i = set.first()[b], j = set.second()[b];
-        if (set.broken()[b] || !(failed[i] || failed[j])) continue;
+        const double stress = std::max(rdef_equivalent_[i], rdef_equivalent_[j]);
+        if (set.broken()[b] || stress < 0.0) continue;
         new_breaks_.push_back({time_, static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(b), FailureCriterion::rdef,
-                               FailureMode::tension, std::max(failed[i] ? equivalent[i] : 0.0, failed[j] ? equivalent[j] : 0.0),
-                               set.bond_energy(b, p)});
+                               FailureMode::tension, stress, set.bond_energy(b, p)});
       }
     }
   }
@@ -287,14 +286,19 @@ void DemModel::apply_failures() {
 }
 
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {
-  std::vector<Sym3> sigma(particles.size(), Sym3{});
+  std::vector<Sym3> sigma;
+  virial_stress(compaction, sigma);
+  return sigma;
+}
+
+void DemModel::virial_stress(double compaction, std::vector<Sym3>& sigma) const {
+  sigma.assign(particles.size(), Sym3{});
   for (const auto& set : bond_sets_) set->accumulate_virial(particles, sigma);
   for (std::size_t i = 0; i < particles.size(); ++i) {
     // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij), Omega_i = (4/3 pi R^3) / compaction.
     const double omega = 4.0 / 3.0 * std::numbers::pi * std::pow(particles.radius[i], 3) / compaction;
     for (double& c : sigma[i]) c /= 2.0 * omega;
   }
-  return sigma;
 }
 
 std::vector<double> DemModel::damage() const {

@@ -97,6 +97,7 @@ class DemModel {
   // Virial stress of every DE over its intact bonds (failure.hpp, seed Eq. 1), Pa, with the
   // volume share Omega_i = sphere volume / compaction.
   std::vector<Sym3> virial_stress(double compaction) const;
+  void virial_stress(double compaction, std::vector<Sym3>& sigma) const;  // into sigma (resized)
   // Fraction of each DE's bonds that are broken (0 for a DE without bonds).
   std::vector<double> damage() const;
 
@@ -146,6 +147,8 @@ class DemModel {
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
+  std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial stress per DE
+  std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
   GroupMask watched_ = 0;
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;
