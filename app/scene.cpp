@@ -432,8 +432,9 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
     check.bounded = c.has("at_most") || c.has("at_least");
     if (check.bounded) {
       if (c.has("expected")) c.fail("expected", "give either expected and tolerance, or at_most / at_least");
-      check.at_most = c.number_or("at_most", INFINITY, Range::any(), unit);
-      check.at_least = c.number_or("at_least", -INFINITY, Range::any(), unit);
+      // Only the bounds given (an unbounded side has no number a case file could hold).
+      if (c.has("at_most")) check.at_most = c.number("at_most", Range::any(), unit);
+      if (c.has("at_least")) check.at_least = c.number("at_least", Range::any(), unit);
     } else {
       check.expected = c.number("expected", Range::any(), unit);
       check.tolerance = c.number("tolerance", Range::positive(), "1");

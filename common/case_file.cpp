@@ -517,18 +517,21 @@ std::vector<Vec3> CaseNode::vec3_list(std::string_view key, Range each, std::str
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
   std::vector<Vec3> out;
-  std::vector<std::string> texts;
+  CaseRecord& list = record_->slot(key, Kind::List);  // a list of [x, y, z] lists
   for (const auto& item : elements(e, expected)) {
     const auto xyz = elements(item, expected);
     if (xyz.size() != 3) mismatch(item, expected);
     Vec3 v;
     for (int k = 0; k < 3; ++k) v[k] = to_number(xyz[k], each, unit, false);
     out.push_back(v);
-    std::string text = "[";
-    text.append(format_number(v.x)).append(", ").append(format_number(v.y)).append(", ").append(format_number(v.z)).append("]");
-    texts.push_back(std::move(text));
+    auto& triple = *list.items.emplace_back(std::make_unique<CaseRecord>());
+    triple.kind = Kind::List;
+    for (int k = 0; k < 3; ++k) {
+      triple.items.push_back(std::make_unique<CaseRecord>());
+      triple.items.back()->kind = Kind::Plain;
+      triple.items.back()->text = format_number(v[k]);
+    }
   }
-  record_->put_list(key, Kind::Plain, texts);
   return out;
 }
 

@@ -1,6 +1,7 @@
 // The cases of cases/ run through the `arlequin` executable, checked against their references.
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <limits>
 
 #include "app/runner.hpp"
@@ -151,6 +152,22 @@ TEST(Cli, CompareReportsErrorAndSpeedUp) {
   EXPECT_LT(sensors[1].at("rms_relative_difference").as_number(), 0.2);  // u_probe
   EXPECT_TRUE(std::filesystem::exists(out / "compare_u_probe.png"));
   EXPECT_TRUE(std::filesystem::exists(out / "compare.csv"));
+}
+
+// case.resolved.yaml (also what `arlequin check` prints) is a case file: read back, it resolves
+// to itself (box regions as [[x, y, z], [x, y, z]], defaults included).
+TEST(Cases, ResolvedCaseReadsBackToItself) {
+  const auto dir = test::scratch_dir("resolved_round_trip");
+  for (const std::string file : {cases + "demo_beam_impact/case.yaml", cases + "lattice_bar_failure/case.yaml",
+                                 cases + "wave_bar_coupled/case.yaml", cases + "cantilever_continuum/case.yaml",
+                                 std::string(ARLEQUIN_SOURCE_DIR) + "/tests/regression/data/two_materials.yaml"}) {
+    const app::Scene first = app::build_scene(file, {});
+    const auto copy = dir / (std::filesystem::path(file).parent_path().filename().string() + ".yaml");
+    std::ofstream(copy) << first.resolved_case;
+    app::Scene second;
+    ASSERT_NO_THROW(second = app::build_scene(copy, {})) << file << "\n" << first.resolved_case;
+    EXPECT_EQ(second.resolved_case, first.resolved_case) << file;
+  }
 }
 
 TEST(Cli, VersionHelpAndCheck) {
