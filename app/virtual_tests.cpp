@@ -412,6 +412,12 @@ std::string QuasiStatic::describe() const {
 
 namespace {
 
+std::size_t bond_count(const dem::DemModel& model) {
+  std::size_t n = 0;
+  for (const auto& set : model.bond_sets()) n += set->size();
+  return n;
+}
+
 // What every test needs before its run: a probe of the case (with the test's own overrides)
 // gives the sample's extent, the modulus behind the time scale and the damping rate.
 struct TestSetup {
@@ -436,6 +442,26 @@ struct TestSetup {
     o.overrides.insert(o.overrides.end(), load.overrides.begin(), load.overrides.end());
     return o;
   }
+  // test.json: the fields every test records (the caller adds its measures), then the run's.
+  Json record(const std::filesystem::path& case_file, const std::string& load, const std::string& plan) const {
+    Json j = Json::object();
+    j["case_file"] = std::filesystem::absolute(case_file).string();
+    j["load"] = load;
+    j["plan"] = plan;
+    j["transit_time"] = transit;
+    j["modulus_estimate"] = modulus;
+    j["modulus_estimate_source"] = affine ? "affine (bond energy under homogeneous strain)" : "given";
+    j["damping"] = damping;
+    return j;
+  }
+  static void write_record(Json& j, const Scene& scene, long steps, double wall_seconds) {
+    j["particles"] = scene.dem.particles.size();
+    j["bonds"] = bond_count(scene.dem);
+    j["steps"] = steps;
+    j["dt"] = scene.dt;
+    j["wall_seconds"] = wall_seconds;
+    write_json_atomically(scene.output.dir / "test.json", j);
+  }
   // Builds and runs the test scene: the probe's options plus `generated`.
   std::pair<Scene, RunResult> run(const std::filesystem::path& case_file, const std::vector<std::string>& generated,
                                   const RunOptions& run_options = {}) const {
@@ -446,12 +472,6 @@ struct TestSetup {
     return {std::move(scene), std::move(result)};
   }
 };
-
-std::size_t bond_count(const dem::DemModel& model) {
-  std::size_t n = 0;
-  for (const auto& set : model.bond_sets()) n += set->size();
-  return n;
-}
 
 }  // namespace
 
@@ -518,15 +538,8 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
     }
   }
 
-  Json j = Json::object();
-  j["case_file"] = std::filesystem::absolute(case_file).string();
+  Json j = setup.record(case_file, load.describe(), plan.describe());
   j["test"] = load.name;
-  j["load"] = load.describe();
-  j["plan"] = plan.describe();
-  j["transit_time"] = r.transit_time;
-  j["modulus_estimate"] = r.modulus_used;
-  j["modulus_estimate_source"] = r.affine_estimate ? "affine (bond energy under homogeneous strain)" : "given";
-  j["damping"] = r.damping;
   j["stress"] = estimate_json(r.stress);
   j["strain"] = estimate_json(r.strain);
   j["modulus"] = estimate_json(r.modulus);
@@ -535,12 +548,7 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   j["gauge_lengths"] = gauges;
   j["force_imbalance"] = r.force_imbalance;
   j["kinetic_to_bond_energy"] = r.kinetic_to_bond;
-  j["particles"] = r.particles;
-  j["bonds"] = r.bonds;
-  j["steps"] = r.steps;
-  j["dt"] = r.dt;
-  j["wall_seconds"] = r.wall_seconds;
-  write_json_atomically(scene.output.dir / "test.json", j);
+  TestSetup::write_record(j, scene, r.steps, r.wall_seconds);
   return r;
 }
 
@@ -654,14 +662,8 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
     r.broken_at_end.emplace_back(set->name, series.rows.back()[c]);
   }
 
-  Json j = Json::object();
-  j["case_file"] = std::filesystem::absolute(case_file).string();
+  Json j = setup.record(case_file, load.describe() + ", to failure", plan.describe());
   j["test"] = load.name;
-  j["load"] = load.describe() + ", to failure";
-  j["plan"] = plan.describe();
-  j["transit_time"] = r.transit_time;
-  j["modulus_estimate"] = setup.modulus;
-  j["damping"] = r.damping;
   j["velocity"] = r.velocity;
   j["failure_stress"] = r.peak_stress;
   j["failure_strain"] = r.strain_at_peak;
@@ -676,12 +678,7 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
   j["breaks"] = r.breaks;
   j["fracture_energy"] = r.fracture_energy;
   j["gauge_length"] = gauge;
-  j["particles"] = r.particles;
-  j["bonds"] = r.bonds;
-  j["steps"] = r.steps;
-  j["dt"] = r.dt;
-  j["wall_seconds"] = r.wall_seconds;
-  write_json_atomically(scene.output.dir / "test.json", j);
+  TestSetup::write_record(j, scene, r.steps, r.wall_seconds);
   return r;
 }
 
