@@ -424,20 +424,23 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
     load.name = "tension_" + std::string(axis_names[spec.failure_axis]);
     load.face = load.direction = spec.failure_axis;
     const bool bbf = target.criterion == "bbf";
+    double threshold = target.initial ? *target.initial : *target.reference;
+    const auto options_at = [&](double s) {  // the case with this target's bond and strength s
+      SceneOptions o = options;
+      o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", strength.E_mu));
+      o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", strength.r_mu));
+      o.overrides.push_back(bbf ? spec.bond_key + ".sigma_f=" + format("%.17g", s) : "dem.failure.rdef.threshold=" + format("%.17g", s));
+      return o;
+    };
     if (!bbf) {  // the RDEF threshold alone must decide
-      const Scene probe = build_scene(spec.case_file, options);
+      const Scene probe = build_scene(spec.case_file, options_at(threshold));
       for (const auto& set : probe.dem.bond_sets())
         if (set->has_strength())
           throw InputError(spec.case_file.string() + ": bond set '" + set->name + "' has a BBF strength (sigma_f); the RDEF target '" +
                            target.name + "' needs a case without one");
     }
-    double threshold = target.initial ? *target.initial : *target.reference;
     for (int round = 0; round < 5; ++round) {
-      SceneOptions o = options;
-      o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", strength.E_mu));
-      o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", strength.r_mu));
-      o.overrides.push_back(bbf ? spec.bond_key + ".sigma_f=" + format("%.17g", threshold)
-                                : "dem.failure.rdef.threshold=" + format("%.17g", threshold));
+      SceneOptions o = options_at(threshold);
       o.out_dir = out_dir / target.name / ("failure_" + target.criterion) / ("round_" + std::to_string(round));
       const FailureTestResult test = run_failure_test(spec.case_file, o, load, plan);
       strength.rounds.push_back({threshold, test});
