@@ -195,7 +195,7 @@ void read_failure(CaseNode failure, dem::DemModel& model, const std::vector<std:
   // BBF strengths belong to the bond laws (sigma_f, max_elongation); RDEF is per DE, with a
   // threshold per material (material_thresholds) or one for every DE (threshold).
   if (auto rdef = failure.child_if("rdef")) {
-    static constexpr std::string_view equivalents[] = {"max_principal", "von_mises"};
+    static constexpr std::string_view equivalents[] = {"max_principal", "von_mises", "hydrostatic"};
     dem::DemModel::RdefSettings settings;
     std::vector<std::string> missing = materials;
     if (auto per_material = rdef->child_if("material_thresholds")) {
@@ -217,7 +217,10 @@ void read_failure(CaseNode failure, dem::DemModel& model, const std::vector<std:
       settings.threshold = std::numeric_limits<double>::infinity();  // every DE has its material's
       if (rdef->has("threshold")) rdef->fail("threshold", "every material has its own threshold in material_thresholds");
     }
-    settings.von_mises = rdef->choice_or("equivalent", "max_principal", equivalents) == "von_mises";
+    const std::string equivalent = rdef->choice_or("equivalent", "max_principal", equivalents);
+    settings.equivalent = equivalent == "von_mises"     ? dem::RdefEquivalent::von_mises
+                          : equivalent == "hydrostatic" ? dem::RdefEquivalent::hydrostatic
+                                                        : dem::RdefEquivalent::max_principal;
     settings.compaction = rdef->number_or("compaction", 0.63, Range::open_between(0.0, 1.0), "1");
     rdef->finish();
     model.enable_rdef(settings);

@@ -10,7 +10,8 @@
 //             bond: {law: <bond law>, tolerance, ...law parameters},      (optional)
 //             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
 //             damping [1/s], failure: {rdef: {threshold [Pa], material_thresholds: {<material>: [Pa]},
-//                                                equivalent, compaction}}}
+//                                                equivalent: max_principal | von_mises | hydrostatic,
+//                                                compaction}}}
 //             (BBF strengths are bond-law parameters: sigma_f for beams, max_elongation for springs)
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
 //   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rise, rotation,

@@ -255,7 +255,7 @@ void DemModel::apply_failures() {
     virial_stress(rdef_->compaction, rdef_stress_);
     rdef_equivalent_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
-      const double equivalent = rdef_->von_mises ? von_mises(rdef_stress_[i]) : max_principal(rdef_stress_[i]);
+      const double equivalent = equivalent_stress(rdef_stress_[i], rdef_->equivalent);
       rdef_equivalent_[i] = equivalent >= rdef_threshold_[i] ? equivalent : -1.0;  // -1: the DE holds
     }
     for (std::size_t s = 0; s < bond_sets_.size(); ++s) {

@@ -69,7 +69,7 @@ class DemModel {
   // other DE `threshold` (infinite: such DEs never fail by RDEF).
   struct RdefSettings {
     double threshold = 0.0;   // Pa
-    bool von_mises = false;   // else the maximal principal stress
+    RdefEquivalent equivalent = RdefEquivalent::max_principal;
     double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
     std::vector<std::pair<int, double>> group_thresholds;  // (group index, Pa), e.g. per material
   };

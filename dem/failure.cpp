@@ -26,6 +26,17 @@ double von_mises(const Sym3& t) {
   return std::sqrt(0.5 * (d01 * d01 + d12 * d12 + d20 * d20) + 3.0 * (t[3] * t[3] + t[4] * t[4] + t[5] * t[5]));
 }
 
+double hydrostatic(const Sym3& t) { return (t[0] + t[1] + t[2]) / 3.0; }
+
+double equivalent_stress(const Sym3& t, RdefEquivalent kind) {
+  switch (kind) {
+    case RdefEquivalent::max_principal: return max_principal(t);
+    case RdefEquivalent::von_mises: return von_mises(t);
+    case RdefEquivalent::hydrostatic: return hydrostatic(t);
+  }
+  return 0.0;
+}
+
 std::string_view name_of(FailureCriterion c) {
   switch (c) {
     case FailureCriterion::bbf: return "bbf";

@@ -6,8 +6,9 @@
 //   sigma_i = 1 / (2 Omega_i) sum_j 1/2 (r_ij (x) f_ij + f_ij (x) r_ij),
 // r_ij = x_j - x_i, f_ij the force of the bond on DE i (towards j in tension, so tension is
 // positive), Omega_i the DE's volume share (sphere volume / compaction, so the shares add up to
-// the sample volume). When its equivalent stress reaches the threshold, every bond of the DE
-// breaks; the DE stays and interacts by contact.
+// the sample volume). When its equivalent stress (the largest principal stress, von Mises, or
+// the hydrostatic stress) reaches the threshold, every bond of the DE breaks; the DE stays and
+// interacts by contact.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -33,6 +34,11 @@ inline void add_symmetric_product(Sym3& t, const Vec3& a, const Vec3& b) {
 // Largest eigenvalue of a symmetric tensor (closed form, trigonometric).
 double max_principal(const Sym3& t);
 double von_mises(const Sym3& t);
+double hydrostatic(const Sym3& t);  // trace / 3 (tension positive)
+
+// The equivalent stress an RDEF threshold is compared with.
+enum class RdefEquivalent : std::uint8_t { max_principal, von_mises, hydrostatic };
+double equivalent_stress(const Sym3& t, RdefEquivalent kind);
 
 enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef };
 enum class FailureMode : std::uint8_t { tension, compression, bending, shear, torsion };

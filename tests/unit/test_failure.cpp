@@ -101,6 +101,9 @@ TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
   EXPECT_NEAR(sigma[centre][0], applied, 0.02 * applied);
   for (int c = 1; c < 6; ++c) EXPECT_NEAR(sigma[centre][c], 0.0, 1e-9 * applied);
   EXPECT_NEAR(max_principal(sigma[centre]), sigma[centre][0], 1e-9 * applied);
+  // Uniaxial: von Mises equals the axial stress, the hydrostatic stress a third of it.
+  EXPECT_NEAR(equivalent_stress(sigma[centre], RdefEquivalent::von_mises), sigma[centre][0], 1e-9 * applied);
+  EXPECT_NEAR(equivalent_stress(sigma[centre], RdefEquivalent::hydrostatic), sigma[centre][0] / 3.0, 1e-9 * applied);
 }
 
 TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
@@ -109,7 +112,7 @@ TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
   test::bond_all_touching(model, {2e11, 0.3, 0.5});
   // DE 2 carries 2.36e7 Pa (both bonds stretched 1e-6 m), DEs 1 and 3 half of it.
-  model.enable_rdef({1.8e7, false, 0.63, {}});
+  model.enable_rdef({1.8e7, RdefEquivalent::max_principal, 0.63, {}});
   model.finalize();
   // Stretch the middle DE's two bonds only: move DEs 3 and 4 right, 0 and 1 left.
   for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
@@ -138,7 +141,7 @@ TEST(Rdef, EachGroupFailsAtItsOwnThreshold) {
   const int hub = model.add_group("hub"), side = model.add_group("side");
   model.particles.groups[2] |= GroupMask{1} << hub;
   model.particles.groups[1] |= GroupMask{1} << side;
-  DemModel::RdefSettings settings{1.5e7, false, 0.63, {}};
+  DemModel::RdefSettings settings{1.5e7, RdefEquivalent::max_principal, 0.63, {}};
   settings.group_thresholds = {{hub, 3.0e7}, {side, 1.0e7}};
   model.enable_rdef(settings);
   model.finalize();
