@@ -287,7 +287,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
       spec.failure_axis = int(it - std::begin(axis_names));
     }
     spec.failure_tolerance = failure->number_or("tolerance", spec.failure_tolerance, Range::open_between(0.0, 1.0), "1");
-    spec.failure_plan = FailurePlan::read(failure->child_if("test"), FailurePlan{});
+    spec.failure_plan = FailurePlan::read(failure->child_if("test"));
     static constexpr std::string_view criteria[] = {"bbf", "rdef"};
     for (CaseNode t : failure->list("targets")) {
       FailureTarget target;

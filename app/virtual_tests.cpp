@@ -552,8 +552,8 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   return r;
 }
 
-FailurePlan FailurePlan::read(std::optional<CaseNode> node, const FailurePlan& defaults) {
-  FailurePlan f = defaults;
+FailurePlan FailurePlan::read(std::optional<CaseNode> node) {
+  FailurePlan f;
   if (!node) return f;
   f.expected_strain = node->number_or("expected_strain", f.expected_strain, Range::open_between(0.0, 0.5), "1");
   f.transits = node->number_or("transits", f.transits, Range::positive(), "transit times");
@@ -823,7 +823,7 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   }
   if (failure_node) {
     if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
-    const FailurePlan failure = FailurePlan::read(failure_node, FailurePlan{});
+    const FailurePlan failure = FailurePlan::read(failure_node);
     root.finish();
     return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, failure);
   }

@@ -126,8 +126,8 @@ struct FailurePlan {
   double rows_per_transit = 20.0;
   int frames = 0;                // HDF5/XDMF frames of particles and bonds over the run (0: none)
 
-  // Reads an optional mapping with the fields above over `defaults`.
-  static FailurePlan read(std::optional<CaseNode> node, const FailurePlan& defaults);
+  // Reads an optional mapping with the fields above (absent ones keep their defaults).
+  static FailurePlan read(std::optional<CaseNode> node);
   std::string describe() const;
 };
 

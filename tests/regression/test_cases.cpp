@@ -158,7 +158,7 @@ TEST(Cli, CompareReportsErrorAndSpeedUp) {
 // to itself (box regions as [[x, y, z], [x, y, z]], defaults included).
 TEST(Cases, ResolvedCaseReadsBackToItself) {
   const auto dir = test::scratch_dir("resolved_round_trip");
-  for (const std::string file : {cases + "demo_beam_impact/case.yaml", cases + "lattice_bar_failure/case.yaml",
+  for (const std::string& file : {cases + "demo_beam_impact/case.yaml", cases + "lattice_bar_failure/case.yaml",
                                  cases + "wave_bar_coupled/case.yaml", cases + "cantilever_continuum/case.yaml",
                                  std::string(ARLEQUIN_SOURCE_DIR) + "/tests/regression/data/two_materials.yaml"}) {
     const app::Scene first = app::build_scene(file, {});
