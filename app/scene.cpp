@@ -221,6 +221,9 @@ void read_failure(CaseNode failure, dem::DemModel& model, const std::vector<std:
     settings.equivalent = equivalent == "von_mises"     ? dem::RdefEquivalent::von_mises
                           : equivalent == "hydrostatic" ? dem::RdefEquivalent::hydrostatic
                                                         : dem::RdefEquivalent::max_principal;
+    static constexpr std::string_view averages[] = {"none", "bonded_neighbours"};
+    settings.average = rdef->choice_or("average", "none", averages) == "bonded_neighbours" ? dem::RdefAverage::bonded_neighbours
+                                                                                            : dem::RdefAverage::none;
     settings.compaction = rdef->number_or("compaction", 0.63, Range::open_between(0.0, 1.0), "1");
     rdef->finish();
     model.enable_rdef(settings);

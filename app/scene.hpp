@@ -11,7 +11,7 @@
 //             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
 //             damping [1/s], failure: {rdef: {threshold [Pa], material_thresholds: {<material>: [Pa]},
 //                                                equivalent: max_principal | von_mises | hydrostatic,
-//                                                compaction}}}
+//                                                average: none | bonded_neighbours, compaction}}}
 //             (BBF strengths are bond-law parameters: sigma_f for beams, max_elongation for springs)
 //   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
 //   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rise, rotation,

@@ -104,10 +104,12 @@ void DemModel::finalize() {
   }
   if (rdef_) {
     rdef_threshold_.assign(particles.size(), rdef_->threshold);
+    rdef_class_.assign(particles.size(), -1);
     for (std::size_t i = 0; i < particles.size(); ++i)
-      for (const auto& [group, threshold] : rdef_->group_thresholds)
-        if (particles.groups[i] & (GroupMask{1} << group)) {
-          rdef_threshold_[i] = threshold;
+      for (std::size_t g = 0; g < rdef_->group_thresholds.size(); ++g)
+        if (particles.groups[i] & (GroupMask{1} << rdef_->group_thresholds[g].first)) {
+          rdef_threshold_[i] = rdef_->group_thresholds[g].second;
+          rdef_class_[i] = static_cast<int>(g);
           break;
         }
   }
@@ -253,6 +255,7 @@ void DemModel::apply_failures() {
   if (rdef_) {
     const ParticleSet& p = particles;
     virial_stress(rdef_->compaction, rdef_stress_);
+    if (rdef_->average == RdefAverage::bonded_neighbours) average_over_bonded_neighbours(rdef_stress_);
     rdef_equivalent_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
       const double equivalent = equivalent_stress(rdef_stress_[i], rdef_->equivalent);
@@ -283,6 +286,34 @@ void DemModel::apply_failures() {
     neighbours_->build(particles);
   }
   compute_forces();
+}
+
+void DemModel::average_over_bonded_neighbours(std::vector<Sym3>& sigma) {
+  // Omega_k is proportional to R_k^3 (the compaction cancels): sum R^3 sigma / sum R^3, over
+  // the partners with the DE's own threshold (its material): across a fibre-matrix interface
+  // the stresses differ by the stiffness ratio, and mixing them would fail the matrix at once.
+  const ParticleSet& p = particles;
+  rdef_average_.resize(p.size());
+  rdef_volume_.resize(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    rdef_volume_[i] = std::pow(p.radius[i], 3);
+    for (int c = 0; c < 6; ++c) rdef_average_[i][c] = rdef_volume_[i] * sigma[i][c];
+  }
+  for (const auto& set : bond_sets_)
+    for (std::size_t b = 0; b < set->size(); ++b) {
+      if (set->broken()[b]) continue;
+      const std::uint32_t i = set->first()[b], j = set->second()[b];
+      if (rdef_class_[i] != rdef_class_[j]) continue;
+      const double vi = std::pow(p.radius[i], 3), vj = std::pow(p.radius[j], 3);
+      for (int c = 0; c < 6; ++c) {
+        rdef_average_[i][c] += vj * sigma[j][c];
+        rdef_average_[j][c] += vi * sigma[i][c];
+      }
+      rdef_volume_[i] += vj;
+      rdef_volume_[j] += vi;
+    }
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int c = 0; c < 6; ++c) sigma[i][c] = rdef_average_[i][c] / rdef_volume_[i];
 }
 
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {

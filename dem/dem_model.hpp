@@ -66,12 +66,16 @@ class DemModel {
   // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
   // stress reaches the DE's threshold; Omega_i = sphere volume / compaction. A DE in one of
   // the listed groups takes that group's threshold (the first listed that holds it), any
-  // other DE `threshold` (infinite: such DEs never fail by RDEF).
+  // other DE `threshold` (infinite: such DEs never fail by RDEF). With `average` =
+  // bonded_neighbours the stress judged is the volume average over the DE and the DEs of its
+  // threshold group it is still bonded to (failure.hpp), which damps the DE-to-DE scatter of a
+  // random packing.
   struct RdefSettings {
     double threshold = 0.0;   // Pa
     RdefEquivalent equivalent = RdefEquivalent::max_principal;
     double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
     std::vector<std::pair<int, double>> group_thresholds;  // (group index, Pa), e.g. per material
+    RdefAverage average = RdefAverage::none;
   };
   void enable_rdef(const RdefSettings& settings) { rdef_ = settings; }
 
@@ -125,6 +129,7 @@ class DemModel {
   void compute_forces();
   void record_reactions();
   void apply_failures();
+  void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
   std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;
   void apply_loads_and_damping();
@@ -144,11 +149,14 @@ class DemModel {
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
   std::optional<RdefSettings> rdef_;
   std::vector<double> rdef_threshold_;  // Pa, per DE (finalize)
+  std::vector<int> rdef_class_;         // per DE: index of its group threshold, -1 for the default
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial stress per DE
   std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
+  std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega
+  std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (in R^3 units)
   GroupMask watched_ = 0;
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "dem/penalty_contact.hpp"
 #include "dem/spring_bond.hpp"
@@ -154,6 +155,59 @@ TEST(Rdef, EachGroupFailsAtItsOwnThreshold) {
     EXPECT_TRUE(set.first()[e.bond] == 1 || set.second()[e.bond] == 1);
   }
   EXPECT_EQ(model.damage()[3], 0.0);
+}
+
+// Averaged RDEF: DE i is judged by sum_k R_k^3 sigma_k / sum_k R_k^3 over itself and its
+// bonded partners. Same loading as above (equal radii): DE 2's average is the mean of the
+// per-DE stresses of DEs 1, 2, 3; a threshold 1 % under it breaks DE 2's two bonds only (DE 1's
+// average, (sigma_0 + sigma_1 + sigma_2) / 3 with sigma_0 = 0, is 25 % lower), 1 % over it none,
+// though the per-DE stress of DE 2 is 50 % above.
+TEST(Rdef, AveragedOverBondedNeighboursBreaksAtTheNeighbourhoodMean) {
+  const double R = 1e-3;
+  const auto run = [&](double threshold_factor) {
+    auto model = std::make_unique<DemModel>();
+    build_chain(model->particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
+    test::bond_all_touching(*model, {2e11, 0.3, 0.5});
+    for (std::size_t i : {0u, 1u}) model->particles.position[i].x -= 1e-6;
+    for (std::size_t i : {3u, 4u}) model->particles.position[i].x += 1e-6;
+    const auto sigma = model->virial_stress(0.63);  // per DE, before any step
+    const double mean = (sigma[1][0] + sigma[2][0] + sigma[3][0]) / 3.0;
+    EXPECT_NEAR(sigma[2][0], 1.5 * mean, 1e-9 * mean);
+    DemModel::RdefSettings settings{threshold_factor * mean, RdefEquivalent::max_principal, 0.63, {}};
+    settings.average = RdefAverage::bonded_neighbours;
+    model->enable_rdef(settings);
+    model->finalize();
+    model->step(1e-12);
+    return model;
+  };
+  const auto below = run(0.99);
+  ASSERT_EQ(below->breaks().size(), 2u);
+  for (const auto& e : below->breaks()) {
+    const auto& set = *below->bond_sets()[e.set];
+    EXPECT_TRUE(set.first()[e.bond] == 2 || set.second()[e.bond] == 2);
+  }
+  EXPECT_TRUE(run(1.01)->breaks().empty());
+}
+
+// The average stays within a material: with DE 3 in a group of its own (another threshold),
+// DE 2's neighbourhood is DEs 1 and 2 only, mean 1.5 sigma_1 instead of 4/3 sigma_1.
+TEST(Rdef, AverageLeavesOutPartnersOfAnotherThresholdGroup) {
+  DemModel model;
+  const double R = 1e-3;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
+  test::bond_all_touching(model, {2e11, 0.3, 0.5});
+  const int other = model.add_group("other");
+  model.particles.groups[3] |= GroupMask{1} << other;
+  for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
+  for (std::size_t i : {3u, 4u}) model.particles.position[i].x += 1e-6;
+  const double sigma_1 = model.virial_stress(0.63)[1][0];
+  DemModel::RdefSettings settings{1.45 * sigma_1, RdefEquivalent::max_principal, 0.63, {{other, 1e30}}};
+  settings.average = RdefAverage::bonded_neighbours;
+  model.enable_rdef(settings);
+  model.finalize();
+  model.step(1e-12);
+  ASSERT_EQ(model.breaks().size(), 2u);
+  EXPECT_EQ(model.damage()[2], 1.0);
 }
 
 // Two DEs bonded by a weak beam are pulled apart until it breaks; sent back towards each other,
