@@ -1,10 +1,12 @@
 #include "app/calibrate.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 
+#include "app/text.hpp"
 #include "common/atomic_file.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
@@ -13,14 +15,6 @@
 
 namespace arlequin::app {
 namespace {
-
-constexpr std::string_view axis_names[] = {"x", "y", "z"};
-
-std::string format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, pattern, value);
-  return buffer;
-}
 
 // Mean of n estimates with uncertainty sqrt(sum u_i^2 / n^2 + s^2 / n) (header).
 Estimate pooled(const std::vector<Estimate>& v) {
@@ -143,14 +137,14 @@ void write_strengths(const CalibrationResult& result, const std::filesystem::pat
     const auto& t = s.target;
     for (std::size_t n = 0; n < s.rounds.size(); ++n) {
       const FailureTestResult& r = s.rounds[n].test;
-      csv += t.name + "," + t.criterion + "," + std::to_string(n) + format(",%.9g", s.rounds[n].threshold) + format(",%.9g", s.E_mu) +
+      csv += t.name + "," + t.label() + "," + std::to_string(n) + format(",%.9g", s.rounds[n].threshold) + format(",%.9g", s.E_mu) +
              format(",%.9g", s.r_mu) + format(",%.9g", r.peak_stress) + format(",%.6g", r.strain_at_peak) + format(",%.9g", t.stress) +
-             format(",%.4g", r.peak_stress / t.stress - 1.0) + format(",%.4g", r.broken_at_peak.empty() ? 0.0 : r.broken_at_peak[0].second) +
-             format(",%.4g", r.broken_at_end.empty() ? 0.0 : r.broken_at_end[0].second) + "," + std::to_string(r.particles) +
+             format(",%.4g", r.peak_stress / t.stress - 1.0) + "," + broken_text(r.broken_at_peak, "; ") +
+             "," + broken_text(r.broken_at_end, "; ") + "," + std::to_string(r.particles) +
              format(",%.1f", r.wall_seconds) + "\n";
     }
     const auto& last = s.rounds.back();
-    md += "| " + t.name + " | " + t.criterion + " | " + format("%.4g", t.stress * 1e-9) + " | " + format("%.5g", last.threshold * 1e-9) +
+    md += "| " + t.name + " | " + t.label() + " | " + format("%.4g", t.stress * 1e-9) + " | " + format("%.5g", last.threshold * 1e-9) +
           " | " + format("%.4g", last.test.peak_stress * 1e-9) + " | " + format("%+.2f %%", 100.0 * (last.test.peak_stress / t.stress - 1.0)) +
           " | " + format("%.4g", last.test.strain_at_peak) + " | " + std::to_string(s.rounds.size()) + (s.converged ? "" : " (not converged)") +
           " | " + (t.reference ? format("%.4g", *t.reference * 1e-9) : std::string("-")) + " | " + format("%.5g", s.E_mu * 1e-9) + " | " +
@@ -158,6 +152,7 @@ void write_strengths(const CalibrationResult& result, const std::filesystem::pat
     Json j = Json::object();
     j["name"] = t.name;
     j["criterion"] = t.criterion;
+    if (!t.variant.empty()) j["variant"] = t.variant;
     j["target_stress"] = t.stress;
     j["threshold"] = last.threshold;
     j["failure_stress"] = last.test.peak_stress;
@@ -255,11 +250,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
   }
   if (root.has("axes")) {
     spec.axes.clear();
-    for (const std::string& a : root.strings("axes")) {
-      const auto it = std::find(std::begin(axis_names), std::end(axis_names), a);
-      if (it == std::end(axis_names)) root.fail("axes", "expected a list of x, y, z, got '" + a + "'");
-      spec.axes.push_back(int(it - std::begin(axis_names)));
-    }
+    for (const std::string& a : root.strings("axes")) spec.axes.push_back(axis_index(root, "axes", a));
     if (spec.axes.empty()) root.fail("axes", "expected at least one axis");
   }
   spec.tolerance = root.number_or("tolerance", spec.tolerance, Range::positive(), "1");
@@ -280,12 +271,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
     spec.targets.push_back(target);
   }
   if (auto failure = root.child_if("failure")) {
-    if (failure->has("axis")) {
-      const std::string a = failure->string("axis");
-      const auto it = std::find(std::begin(axis_names), std::end(axis_names), a);
-      if (it == std::end(axis_names)) failure->fail("axis", "expected x, y or z, got '" + a + "'");
-      spec.failure_axis = int(it - std::begin(axis_names));
-    }
+    if (failure->has("axis")) spec.failure_axis = axis_index(*failure, "axis", failure->string("axis"));
     spec.failure_tolerance = failure->number_or("tolerance", spec.failure_tolerance, Range::open_between(0.0, 1.0), "1");
     spec.failure_plan = FailurePlan::read(failure->child_if("test"));
     static constexpr std::string_view criteria[] = {"bbf", "rdef"};
@@ -307,6 +293,13 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
       if (t.has("initial")) target.initial = t.number("initial", Range::positive(), "Pa");
       if (t.has("reference")) target.reference = t.number("reference", Range::positive(), "Pa");
       if (!target.initial && !target.reference) t.fail("initial", "give a first guess (initial) or a published value (reference)");
+      target.variant = t.string_or("variant", "");
+      if (!std::all_of(target.variant.begin(), target.variant.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
+        t.fail("variant", "expected a name of letters, digits and '_' (it names a folder), got '" + target.variant + "'");
+      if (t.has("set")) {
+        if (target.variant.empty()) t.fail("set", "name the variant these options make (variant: ...)");
+        target.overrides = t.strings("set");
+      }
       t.finish();
       spec.failure_targets.push_back(target);
     }
@@ -427,6 +420,7 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
     double threshold = target.initial ? *target.initial : *target.reference;
     const auto options_at = [&](double s) {  // the case with this target's bond and strength s
       SceneOptions o = options;
+      o.overrides.insert(o.overrides.end(), target.overrides.begin(), target.overrides.end());
       o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", strength.E_mu));
       o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", strength.r_mu));
       o.overrides.push_back(bbf ? spec.bond_key + ".sigma_f=" + format("%.17g", s) : "dem.failure.rdef.threshold=" + format("%.17g", s));
@@ -441,16 +435,16 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
     }
     for (int round = 0; round < 5; ++round) {
       SceneOptions o = options_at(threshold);
-      o.out_dir = out_dir / target.name / ("failure_" + target.criterion) / ("round_" + std::to_string(round));
+      o.out_dir = out_dir / target.name / ("failure_" + target.label()) / ("round_" + std::to_string(round));
       const FailureTestResult test = run_failure_test(spec.case_file, o, load, plan);
       strength.rounds.push_back({threshold, test});
       const double error = test.peak_stress / target.stress - 1.0;
       std::printf("%s %s round %d: threshold %.6g GPa -> sigma_M = %.5g GPa at strain %.4g (target %.5g GPa, %+.2f %%), %.0f s\n",
-                  target.name.c_str(), target.criterion.c_str(), round, threshold * 1e-9, test.peak_stress * 1e-9,
+                  target.name.c_str(), target.label().c_str(), round, threshold * 1e-9, test.peak_stress * 1e-9,
                   test.strain_at_peak, target.stress * 1e-9, 100.0 * error, test.wall_seconds);
       std::fflush(stdout);
       if (!test.broke)
-        throw RunError("calibrate: " + target.name + " (" + target.criterion + ") did not break by strain " +
+        throw RunError("calibrate: " + target.name + " (" + target.label() + ") did not break by strain " +
                        format("%.4g", test.final_strain) + "; raise failure.test.max_strain_factor or lower the first guess");
       if (std::abs(error) <= spec.failure_tolerance) {
         strength.converged = true;

@@ -51,6 +51,10 @@ struct FailureTarget {
   double stress = 0.0;    // Pa, sigma_f macro
   std::optional<double> young, E_mu, r_mu;     // Pa, Pa, 1: required without an elastic target of that name
   std::optional<double> initial, reference;   // Pa: first guess (default: reference), a published value
+  std::string variant;                        // optional name of a variant of the criterion
+  std::vector<std::string> overrides;         // its case options ("key=value"), e.g. RDEF's average
+  // "bbf", "rdef" or "rdef_<variant>": folders and tables.
+  std::string label() const { return variant.empty() ? criterion : criterion + "_" + variant; }
 };
 
 // Spec file (strict YAML; `arlequin calibrate SPEC.yaml`):
@@ -69,7 +73,9 @@ struct FailureTarget {
 //     tolerance: 0.02        relative, on the failure stress
 //     test: {...}            FailurePlan (virtual_tests.hpp); expected_strain = stress / E
 //     targets: [{name, criterion: bbf | rdef, stress [Pa], E [Pa], E_mu [Pa], r_mu, initial [Pa],
-//                reference [Pa]}]
+//                reference [Pa], variant: name, set: ["key=value", ...]}]
+//                            variant + set: the same criterion with other case options (e.g.
+//                            dem.failure.rdef.average=bonded_neighbours), shown as rdef_<variant>
 struct CalibrationSpec {
   std::filesystem::path case_file;
   std::string bond_key = "dem.bond";

@@ -86,7 +86,7 @@ class Outputs {
         const auto broken = set->broken();
         row_.push_back(double(std::count(broken.begin(), broken.end(), 1)) / double(std::max<std::size_t>(1, set->size())));
       }
-      write_breaks();
+      write_breaks(false);
     }
     series_->append(row_);
     return values;
@@ -102,6 +102,7 @@ class Outputs {
 
   void close() {
     series_->flush();
+    if (scene_.dem.failure_enabled()) write_breaks(true);
     if (fields_) fields_->close();
   }
   const CsvSeries& series() const { return *series_; }
@@ -143,21 +144,28 @@ class Outputs {
     return {};
   }
 
-  // breaks.csv: one row per broken bond, rewritten (atomically) when breaks were added.
-  void write_breaks() {
+  // breaks.csv: one row per broken bond. Rows are formatted once, as the breaks come, and the
+  // file is rewritten atomically at most every 2 s of wall time (as series.csv) and at close,
+  // so a long failure run with many breaks costs linear, not quadratic, I/O.
+  void write_breaks(bool force) {
     const auto& breaks = scene_.dem.breaks();
-    if (breaks.size() == breaks_written_ && breaks_written_ > 0) return;
-    std::string text = "time,set,bond,group,criterion,mode,stress,energy\n";
+    if (breaks_text_.empty()) breaks_text_ = "time,set,bond,group,criterion,mode,stress,energy\n";
     char line[256];
-    for (const auto& e : breaks) {
+    for (; breaks_formatted_ < breaks.size(); ++breaks_formatted_) {
+      const auto& e = breaks[breaks_formatted_];
       const auto& set = *scene_.dem.bond_sets()[e.set];
       std::snprintf(line, sizeof line, "%.12g,%u,%u,%s,%s,%s,%.9g,%.9g\n", e.time, e.set, e.bond, set.name.c_str(),
                     std::string(dem::name_of(e.criterion)).c_str(), std::string(dem::name_of(e.mode)).c_str(), e.stress,
                     e.energy);
-      text += line;
+      breaks_text_ += line;
     }
-    write_file_atomically(scene_.output.dir / "breaks.csv", text);
-    breaks_written_ = breaks.size();
+    const auto now = std::chrono::steady_clock::now();
+    const bool stale = breaks_on_disk_ < breaks_formatted_ || !breaks_file_written_;
+    if (!stale || (!force && breaks_file_written_ && now - breaks_last_write_ < std::chrono::seconds(2))) return;
+    write_file_atomically(scene_.output.dir / "breaks.csv", breaks_text_);
+    breaks_on_disk_ = breaks_formatted_;
+    breaks_file_written_ = true;
+    breaks_last_write_ = now;
   }
 
   void write_particles() {
@@ -197,7 +205,11 @@ class Outputs {
   std::vector<double> row_;
   std::vector<Vec3> scratch_vec_;
   std::vector<std::int32_t> scratch_int_, scratch_set_, scratch_broken_;
-  std::size_t breaks_written_ = 0;
+  std::string breaks_text_;           // breaks.csv as it will be written
+  std::size_t breaks_formatted_ = 0;  // breaks already in breaks_text_
+  std::size_t breaks_on_disk_ = 0;    // breaks in the file last written
+  bool breaks_file_written_ = false;
+  std::chrono::steady_clock::time_point breaks_last_write_;
   std::vector<std::int64_t> scratch_lines_;
 };
 

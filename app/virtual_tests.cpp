@@ -11,6 +11,7 @@
 
 #include "app/micromechanics.hpp"
 #include "app/runner.hpp"
+#include "app/text.hpp"
 #include "common/atomic_file.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
@@ -19,20 +20,8 @@
 namespace arlequin::app {
 namespace {
 
-constexpr std::string_view axis_names[] = {"x", "y", "z"};
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-int axis_index(CaseNode& node, std::string_view key, const std::string& text) {
-  for (int k = 0; k < 3; ++k)
-    if (text == axis_names[k]) return k;
-  node.fail(key, "expected an axis x, y or z, got '" + text + "'");
-}
-
-std::string format(const char* pattern, double value) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, pattern, value);
-  return buffer;
-}
 std::string number_text(double value) { return format("%.17g", value); }
 // The shortest text that reads back as the same double.
 std::string shortest(double value) {
@@ -726,13 +715,6 @@ struct FailureReference {
     return r;
   }
 };
-
-// "fibre 4.1, matrix 40, ..." (percent); `separator` "; " keeps a CSV cell free of commas.
-std::string broken_text(const std::vector<std::pair<std::string, double>>& fractions, const char* separator = ", ") {
-  std::string text;
-  for (const auto& [name, f] : fractions) text += (text.empty() ? "" : separator) + name + format(" %.3g", 100.0 * f);
-  return text;
-}
 
 std::string describe_failure(const FailureTestResult& r) {
   return format("sigma_fail = %.4g GPa", r.peak_stress * 1e-9) + format(" at strain %.4g", r.strain_at_peak) +
