@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "common/case_file.hpp"
@@ -41,7 +42,7 @@ continuum::Material read_material(CaseNode m) {
 
 class Part final : public ContinuumPart {
  public:
-  Part(CaseNode section, const std::string& extra_petsc_options) {
+  Part(CaseNode section, std::optional<CaseNode> coupling, const std::string& extra_petsc_options) {
     std::vector<std::string_view> names;
     for (const auto& e : continuum::continuum_solvers()) names.push_back(e.name);
     const std::string name = section.choice("solver", names);
@@ -58,6 +59,11 @@ class Part final : public ContinuumPart {
     static constexpr std::string_view analyses[] = {"explicit", "static"};
     static_ = section.choice_or("analysis", "explicit", analyses) == "static";
     petsc_options_ = settings.petsc_options;
+    if (coupling) {
+      if (static_) coupling->fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
+      read_coupling(*coupling);
+      settings.mesh.left_out = [zone = *zone_](const Vec3& x) { return zone.in_pure_dem_zone(x); };
+    }
     try {
       solver_ = continuum::make_continuum_solver(name, settings);
     } catch (const InputError& e) {
@@ -84,25 +90,11 @@ class Part final : public ContinuumPart {
   std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
   double coupling_work() const override { return coupled_ ? coupled_->energies().coupling_work : 0.0; }
 
-  void couple(CaseNode section, dem::DemModel& dem) override {
-    if (static_) section.fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
-    coupling::OverlapZone::Weighting weighting;
-    static constexpr std::string_view shapes[] = {"linear", "cubic", "constant"};
-    weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
-    weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
-    weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
-    const coupling::OverlapZone zone = read_overlap(section.child("overlap"), weighting);
-    coupling::CoupledOptions options;
-    static constexpr std::string_view mediators[] = {"coarse", "fine"};
-    static constexpr std::string_view types[] = {"l2", "h1"};
-    options.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
-    options.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
-    if (options.coupling.type == coupling::CouplingType::h1)
-      options.coupling.length = section.number("length", Range::positive(), "m");
-    section.finish();
-    options.held_continuum_dofs = held_dofs_;
-    options.driven_des = dem.driven_particles();
-    coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, zone, options);
+  bool in_dem_domain(const Vec3& x) const override { return !zone_ || zone_->in_dem_domain(x); }
+  void couple(dem::DemModel& dem) override {
+    options_.held_continuum_dofs = held_dofs_;
+    options_.driven_des = dem.driven_particles();
+    coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
   }
   void solve_static() override { solver_->solve_static(petsc_options_); }
   bool has_group(const std::string& name) const override { return solver_->mesh().has_group(name); }
@@ -113,6 +105,16 @@ class Part final : public ContinuumPart {
     Vec3 sum{};
     for (int n : solver_->mesh().group(group).nodes) sum -= node_vector(solver_->force(), n);
     return sum;
+  }
+  std::array<double, 2> affine_deviation(const std::array<Vec3, 3>& H) const override {
+    std::array<double, 2> out{0.0, 0.0};
+    const auto& X = solver_->nodes();
+    for (std::size_t n = 0; n < X.size(); ++n) {
+      const Vec3 affine{dot(H[0], X[n]), dot(H[1], X[n]), dot(H[2], X[n])};
+      out[0] = std::max(out[0], norm(node_vector(solver_->displacement(), int(n)) - affine));
+      out[1] = std::max(out[1], norm(affine));
+    }
+    return out;
   }
   double kinetic_energy() const override { return solver_->kinetic_energy(); }
   double strain_energy() const override { return solver_->strain_energy(); }
@@ -152,10 +154,27 @@ class Part final : public ContinuumPart {
     counts["continuum_nodes"] = solver_->num_nodes();
     counts["continuum_tetrahedra"] = solver_->mesh().num_tets();
     counts["continuum_order"] = solver_->mesh().order();
+    if (solver_->mesh().tets_left_out() > 0) counts["continuum_tetrahedra_left_out"] = solver_->mesh().tets_left_out();
     if (coupled_) counts["coupled_particles"] = coupled_->operators().num_particles();
   }
 
  private:
+  void read_coupling(CaseNode section) {
+    coupling::OverlapZone::Weighting weighting;
+    static constexpr std::string_view shapes[] = {"linear", "cubic", "constant"};
+    weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
+    weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
+    weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
+    zone_ = read_overlap(section.child("overlap"), weighting);
+    static constexpr std::string_view mediators[] = {"coarse", "fine"};
+    static constexpr std::string_view types[] = {"l2", "h1"};
+    options_.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
+    options_.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
+    if (options_.coupling.type == coupling::CouplingType::h1)
+      options_.coupling.length = section.number("length", Range::positive(), "m");
+    section.finish();
+  }
+
   static Vec3 node_vector(const continuum::Field& f, int n) { return {f[3 * n], f[3 * n + 1], f[3 * n + 2]}; }
   Vec3 node_mean(const continuum::Field& f, const std::string& group) const {
     const auto& nodes = solver_->mesh().group(group).nodes;
@@ -241,6 +260,8 @@ class Part final : public ContinuumPart {
   }
 
   std::unique_ptr<ContinuumSolver> solver_;
+  std::optional<coupling::OverlapZone> zone_;  // with a coupling section
+  coupling::CoupledOptions options_;
   std::unique_ptr<coupling::CoupledModel> coupled_;
   std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)
   std::string petsc_options_;
@@ -249,8 +270,9 @@ class Part final : public ContinuumPart {
 
 }  // namespace
 
-std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, const std::string& extra_petsc_options) {
-  return std::make_unique<Part>(section, extra_petsc_options);
+std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, std::optional<CaseNode> coupling,
+                                                   const std::string& extra_petsc_options) {
+  return std::make_unique<Part>(section, coupling, extra_petsc_options);
 }
 
 }  // namespace arlequin::app

@@ -26,11 +26,15 @@
 //            | {shell: {inner: [[..], [..]], outer: [[..], [..]]}}       (DEM inside `inner`)
 //     weight: linear | cubic | constant   (constant_value: 0.5), mass_floor: 0.05
 //     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
+// The overlap also cuts both models to their domains: tetrahedra with every vertex in the
+// pure-DEM zone are left out of the mesh here, and the scene does not create the sample's DEs
+// beyond the overlap (in_dem_domain), so a mesh and a sample may each cover the whole body.
 // Then step() advances both models together and the DEM is finalized by the coupling.
 #pragma once
 #include <array>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/vec3.hpp"
@@ -51,14 +55,19 @@ namespace arlequin::app {
 
 class ContinuumPart {
  public:
-  // Builds the continuum; InputError for any problem (also when this build has no continuum).
-  static std::unique_ptr<ContinuumPart> read(CaseNode section, const std::string& extra_petsc_options);
+  // Builds the continuum, cut by the coupling's overlap when `coupling` is given; InputError for
+  // any problem (also when this build has no continuum).
+  static std::unique_ptr<ContinuumPart> read(CaseNode section, std::optional<CaseNode> coupling,
+                                             const std::string& extra_petsc_options);
   virtual ~ContinuumPart() = default;
 
   virtual continuum::ContinuumSolver& solver() = 0;
-  // Couples `dem` (built, with its boundary conditions, not finalized) to this continuum; the
-  // coupling finalizes it. std::invalid_argument for contradictory DEM boundary conditions.
-  virtual void couple(CaseNode section, dem::DemModel& dem) = 0;
+  // Where DEs may be: the pure-DEM zone and the overlap of the coupling (everywhere if uncoupled).
+  virtual bool in_dem_domain(const Vec3& x) const = 0;
+  // Couples `dem` (built, with its boundary conditions, not finalized) to this continuum with
+  // the coupling section given to `read`; the coupling finalizes it. std::invalid_argument for
+  // contradictory DEM boundary conditions.
+  virtual void couple(dem::DemModel& dem) = 0;
   virtual bool is_coupled() const = 0;
   virtual std::string coupling_summary() const = 0;  // one line per item, printed at start
   virtual double coupling_work() const = 0;          // J, work of the multiplier forces
@@ -73,6 +82,8 @@ class ContinuumPart {
   virtual Vec3 mean_velocity(const std::string& group) const = 0;      // m/s
   // Force that supports and loads apply to the group's nodes, -(f_ext - f_int) summed, N.
   virtual Vec3 reaction_on(const std::string& group) const = 0;
+  // Over the nodes: {max |u - H X|, max |H X|} (m), H by rows (patch tests).
+  virtual std::array<double, 2> affine_deviation(const std::array<Vec3, 3>& H) const = 0;
   virtual double kinetic_energy() const = 0;
   virtual double strain_energy() const = 0;
   virtual void write_fields(FieldsWriter& fields) const = 0;

@@ -6,7 +6,7 @@
 
 namespace arlequin::app {
 
-std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, const std::string&) {
+std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, std::optional<CaseNode>, const std::string&) {
   section.fail("solver", "this build has no continuum solvers (configure with -DARLEQUIN_WITH_CONTINUUM=ON)");
 }
 

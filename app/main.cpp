@@ -155,7 +155,9 @@ Arguments parse(int argc, char** argv) {
 
 void print_scene_facts(const app::Scene& scene) {
   const auto& model = scene.dem;
-  std::printf("case: %s\n  DEs: %zu\n", scene.name.c_str(), model.particles.size());
+  std::printf("case: %s\n  DEs: %zu", scene.name.c_str(), model.particles.size());
+  if (scene.des_not_created > 0) std::printf(" (%zu more of the sample lie beyond the overlap: not created)", scene.des_not_created);
+  std::printf("\n");
   if (scene.sample) {
     const auto& r = scene.sample->report;
     std::printf("  packing (%s): compaction %.4f, coordination %.2f (interior %.2f), fabric eigenvalues %.4f %.4f %.4f,"

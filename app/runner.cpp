@@ -140,8 +140,25 @@ class Outputs {
         return s.on_continuum ? scene_.continuum->mean_velocity(s.group_name) : scene_.dem.mean_velocity(s.group);
       case Sensor::Kind::energy:
         return {scene_.dem.group_energy(s.group), 0.0, 0.0};
+      case Sensor::Kind::affine_deviation:
+        return {affine_deviation(), 0.0, 0.0};
     }
     return {};
+  }
+
+  // max |u - H X| / max |H X| over the DEs (u = position - reference, X = reference) and the
+  // continuum nodes.
+  double affine_deviation() const {
+    const auto& H = *scene_.initial_gradient;
+    std::array<double, 2> m = scene_.continuum ? scene_.continuum->affine_deviation(H) : std::array<double, 2>{0.0, 0.0};
+    const dem::ParticleSet& p = scene_.dem.particles;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Vec3& X = p.reference[i];
+      const Vec3 affine{dot(H[0], X), dot(H[1], X), dot(H[2], X)};
+      m[0] = std::max(m[0], norm(p.position[i] - X - affine));
+      m[1] = std::max(m[1], norm(affine));
+    }
+    return m[1] > 0.0 ? m[0] / m[1] : m[0];
   }
 
   // breaks.csv: one row per broken bond. Rows are formatted once, as the breaks come, and the
@@ -375,6 +392,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["dt_critical"] = scene.dt_critical;
   Json& counts = summary["counts"];
   counts["particles"] = model.particles.size();
+  if (scene.des_not_created > 0) counts["particles_not_created"] = scene.des_not_created;
   if (model.failure_enabled()) counts["broken_bonds"] = model.breaks().size();
   if (!model.bond_sets().empty()) {
     Json& bonds = counts["bonds"];

@@ -85,11 +85,16 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
     dem::build_chain(p, start, normalized(direction), int(count), spacing, radius, density);
   }
+  // Coupled: the built DEs beyond the overlap (in the pure-continuum zone) are not created.
+  if (scene.continuum)
+    scene.des_not_created = p.keep_only([&](std::size_t i) { return scene.continuum->in_dem_domain(p.position[i]); });
   // Explicit DEs (an impactor, a two-body test), after the built ones; the only ones for
   // build: particles.
   const auto listed = build == "particles" ? sample.list("particles") : sample.list_or_empty("particles");
   for (CaseNode item : listed) {
     const Vec3 x = item.vec3("position", Range::any(), "m");
+    if (scene.continuum && !scene.continuum->in_dem_domain(x))
+      item.fail("position", "this DE lies beyond the coupling overlap, in the pure-continuum zone");
     const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), density);
     p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
     item.finish();
@@ -305,13 +310,12 @@ void read_boundary(CaseNode root, dem::DemModel& model) {
 
 // Finalizes the DEM, through the coupling when the case couples it to the continuum; a
 // contradiction between boundary conditions is reported at the boundary section.
-void finalize_dem(CaseNode root, Scene& scene) {
-  std::optional<CaseNode> coupling = root.child_if("coupling");
-  if (coupling && (!scene.continuum || scene.dem.particles.size() == 0))
-    coupling->fail("overlap", "coupling needs both a dem and a continuum section");
+void finalize_dem(CaseNode root, Scene& scene, bool coupled) {
+  if (coupled && scene.dem.particles.size() == 0)
+    root.fail("coupling", "no DE of the sample lies in the DEM domain (the pure-DEM zone and the overlap)");
   try {
-    if (coupling)
-      scene.continuum->couple(*coupling, scene.dem);
+    if (coupled)
+      scene.continuum->couple(scene.dem);
     else
       scene.dem.finalize();
   } catch (const std::invalid_argument& e) {
@@ -372,10 +376,11 @@ void read_initial_strain(CaseNode root, Scene& scene) {
   const std::array<Vec3, 3> H{rows[0], rows[1], rows[2]};
   for (Vec3& x : scene.dem.particles.position) x += Vec3{dot(H[0], x), dot(H[1], x), dot(H[2], x)};
   if (scene.continuum) scene.continuum->set_affine_displacement(H);
+  scene.initial_gradient = H;
 }
 
 void read_sensors(CaseNode root, Scene& scene) {
-  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy"};
+  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy", "affine_deviation"};
   static constexpr std::string_view models[] = {"dem", "continuum"};
   const bool has_dem = scene.dem.particles.size() > 0;
   for (CaseNode s : root.list_or_empty("sensors")) {
@@ -386,6 +391,15 @@ void read_sensors(CaseNode root, Scene& scene) {
     for (const Sensor& other : scene.sensors)
       if (other.name == sensor.name) s.fail("name", "sensor '" + sensor.name + "' is defined twice");
     const std::string type = s.choice("type", types);
+    if (type == "affine_deviation") {
+      // A patch test's measure: the whole scene against the initial_strain field.
+      if (!scene.initial_gradient) s.fail("type", "an affine_deviation sensor needs an initial_strain section");
+      sensor.kind = Sensor::Kind::affine_deviation;
+      sensor.component = 0;
+      s.finish();
+      scene.sensors.push_back(sensor);
+      continue;
+    }
     sensor.kind = type == "force"          ? Sensor::Kind::force
                   : type == "displacement" ? Sensor::Kind::displacement
                   : type == "velocity"     ? Sensor::Kind::velocity
@@ -515,6 +529,12 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   std::optional<CaseNode> dem_node = root.child_if("dem");
   std::optional<CaseNode> continuum_node = root.child_if("continuum");
   if (!dem_node && !continuum_node) root.fail("dem", "a case needs a dem section, a continuum section, or both");
+  std::optional<CaseNode> coupling = root.child_if("coupling");
+  if (coupling && (!dem_node || !continuum_node))
+    coupling->fail("overlap", "coupling needs both a dem and a continuum section");
+  // The continuum first: a coupling's overlap cuts the DEM sample to its domain.
+  if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, coupling, options.petsc_options);
+  const bool static_only = !dem_node && scene.continuum->is_static();
   dem::DemModel& model = scene.dem;
   if (dem_node) {
     std::vector<std::string> materials;
@@ -541,8 +561,6 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
     if (auto failure = dem_node->child_if("failure")) read_failure(*failure, model, materials);
     dem_node->finish();
   }
-  if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, options.petsc_options);
-  const bool static_only = !dem_node && scene.continuum->is_static();
 
   if (dem_node) {
     read_groups(root, model);
@@ -552,7 +570,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   read_initial_strain(root, scene);
   read_sensors(root, scene);
   if (dem_node) read_boundary(root, model);
-  finalize_dem(root, scene);
+  finalize_dem(root, scene, coupling.has_value());
 
   std::optional<CaseNode> time = static_only ? root.child_if("time") : root.child("time");
   scene.end_time = time ? time->number("end", Range::positive(), "s") : 1.0;

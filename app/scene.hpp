@@ -21,13 +21,15 @@
 //   pulse:    {group, direction, center [m], wavelength [m], amplitude [m/s], speed [m/s]}: a
 //             raised-cosine velocity pulse travelling along `direction` (DEM)
 //   sensors:  [{name, type: force | displacement | velocity | energy, group, component: x | y | z | all,
-//               on: dem | continuum (default: the model the case has; dem if both)}]
+//               on: dem | continuum (default: the model the case has; dem if both)}
+//              | {name, type: affine_deviation}]  (needs initial_strain: see Sensor)
 //   checks:   [{column, statistic: final | max | min | final_over_initial, expected, tolerance, note}
 //              | {column, statistic, at_most, at_least, note}
 //              | {column, crossing: value, expected: time [s], tolerance, note}]
 //   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s],
 //              plots: [{file, title, x, x_scale, x_label, y: [..], y_scale, y_label, y2: [..], y2_scale, y2_label}]}
 #pragma once
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -41,7 +43,9 @@
 namespace arlequin::app {
 
 struct Sensor {
-  enum class Kind { force, displacement, velocity, energy };  // energy: DEM groups, one column
+  // energy: DEM groups, one column; affine_deviation: one column, the whole scene's
+  // max |u - H X| / max |H X| over DEs and continuum nodes against initial_strain's H.
+  enum class Kind { force, displacement, velocity, energy, affine_deviation };
   std::string name;
   Kind kind = Kind::force;
   bool on_continuum = false;  // else on the DEM
@@ -91,6 +95,8 @@ struct Scene {
   std::unique_ptr<ContinuumPart> continuum;    // null without a continuum section
   std::optional<dem::SampleRecord> sample;     // with build: packing: its spec and report
   std::filesystem::path sample_file;           // where the packing is cached
+  std::size_t des_not_created = 0;             // sample DEs beyond a coupling's overlap
+  std::optional<std::array<Vec3, 3>> initial_gradient;  // initial_strain's H, by rows
   double end_time = 0.0;      // s
   double dt = 0.0;            // s
   double dt_critical = 0.0;   // s

@@ -1,6 +1,8 @@
 #include "app/sweep.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -9,6 +11,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
+#include "common/png_plot.hpp"
 
 namespace arlequin::app {
 
@@ -17,78 +20,180 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
     throw InputError("--over " + text + ": expected key.path=value1,value2,...");
   SweepAxis axis{text.substr(0, eq), {}};
-  std::stringstream values(text.substr(eq + 1));
-  for (std::string v; std::getline(values, v, ',');)
-    if (!v.empty()) axis.values.push_back(v);
+  // Values split at the commas outside brackets, so a value may be a YAML list ([[..], [..]]).
+  int depth = 0;
+  std::string value;
+  for (char c : text.substr(eq + 1)) {
+    depth += c == '[' ? 1 : c == ']' ? -1 : 0;
+    if (depth < 0) throw InputError("--over " + text + ": unbalanced ']'");
+    if (c == ',' && depth == 0) {
+      if (!value.empty()) axis.values.push_back(value);
+      value.clear();
+    } else {
+      value += c;
+    }
+  }
+  if (depth != 0) throw InputError("--over " + text + ": unbalanced '['");
+  if (!value.empty()) axis.values.push_back(value);
   return axis;
 }
+
+namespace {
+
+// sweep.png: the first check's value against the first axis when its values are numbers (one
+// line per combination of the other axes), else against the wall time (one point per run).
+void plot_sweep(const std::filesystem::path& file, const std::vector<SweepAxis>& axes,
+                const std::vector<std::vector<std::string>>& picked, const std::vector<double>& value,
+                const std::vector<double>& wall, const std::string& check) {
+  std::vector<double> first(picked.size());
+  bool numeric = true;
+  for (std::size_t r = 0; r < picked.size(); ++r) {
+    char* end = nullptr;
+    first[r] = std::strtod(picked[r][0].c_str(), &end);
+    numeric = numeric && end != picked[r][0].c_str() && *end == '\0';
+  }
+  PlotSpec spec;
+  spec.title = "arlequin sweep: " + check;
+  spec.y_label = check + " (checked value)";
+  spec.x_label = numeric ? axes[0].key : "wall time (s)";
+  spec.log_y = std::all_of(value.begin(), value.end(), [](double v) { return v > 0.0; });
+  std::vector<std::string> labels;
+  for (std::size_t r = 0; r < picked.size(); ++r) {
+    std::string label;
+    for (std::size_t k = numeric ? 1 : 0; k < axes.size(); ++k)
+      label += (label.empty() ? "" : ", ") + axes[k].key.substr(axes[k].key.rfind('.') + 1) + "=" + picked[r][k];
+    auto it = std::find(labels.begin(), labels.end(), label);
+    if (it == labels.end()) {
+      labels.push_back(label);
+      spec.series.push_back({label, {}, {}, numeric ? PlotSeries::Style::line_points : PlotSeries::Style::points});
+      it = labels.end() - 1;
+    }
+    PlotSeries& series = spec.series[it - labels.begin()];
+    series.x.push_back(numeric ? first[r] : wall[r]);
+    series.y.push_back(value[r]);
+  }
+  write_png_plot(file, spec);
+}
+
+}  // namespace
+
+namespace {
+
+struct SweepRow {
+  std::vector<std::string> picked;  // one value per axis
+  std::size_t particles = 0;
+  long nodes = 0, steps = 0;
+  std::vector<std::pair<double, double>> checks;  // value, relative error; empty if not run
+  double wall = 0.0;
+  std::string status;
+};
+
+// One Markdown line and one CSV row; a run that never got to its checks shows "-" there.
+std::pair<std::string, std::string> format_row(const SweepRow& row, std::size_t num_checks) {
+  std::string line = "|", csv;
+  for (const auto& v : row.picked) line += " " + v + " |", csv += v + ",";
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, " %zu | %ld | %ld |", row.particles, row.nodes, row.steps);
+  line += buffer;
+  csv += std::to_string(row.particles) + "," + std::to_string(row.nodes) + "," + std::to_string(row.steps) + ",";
+  for (std::size_t c = 0; c < num_checks; ++c) {
+    if (c < row.checks.size()) {
+      std::snprintf(buffer, sizeof buffer, " %.6g | %.3g %% |", row.checks[c].first, 100 * row.checks[c].second);
+      line += buffer;
+      std::snprintf(buffer, sizeof buffer, "%.9g,%.6g,", row.checks[c].first, row.checks[c].second);
+      csv += buffer;
+    } else {
+      line += " - | - |", csv += ",,";
+    }
+  }
+  std::snprintf(buffer, sizeof buffer, " %.3f | %s |", row.wall, row.status.c_str());
+  line += buffer;
+  std::snprintf(buffer, sizeof buffer, "%.6f,%s", row.wall, row.status.c_str());
+  csv += buffer;
+  return {line, csv};
+}
+
+}  // namespace
 
 bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base, const std::vector<SweepAxis>& axes,
                const std::filesystem::path& out_dir) {
   std::size_t runs = 1;
   for (const auto& a : axes) runs *= a.values.size();
-  std::string csv, header;
+  std::vector<std::string> check_names;  // from the first scene built
+  bool columns_known = false, header_printed = false;
+  std::vector<SweepRow> rows;
+  std::size_t printed = 0;
+  // Rows are printed as they come once the check columns are known (from the first scene that
+  // could be built); a run whose scene could not be built still gets its row.
+  const auto print_rows = [&](bool final) {
+    if (!header_printed && (columns_known || final)) {
+      std::string md = "|", rule = "|";
+      for (const auto& a : axes) md += " " + a.key + " |", rule += "---|";
+      md += " DEs | nodes | steps |", rule += "---|---|---|";
+      for (const auto& c : check_names) md += " " + c + " | error |", rule += "---|---|";
+      md += " wall s | status |", rule += "---|---|";
+      std::printf("%s\n%s\n", md.c_str(), rule.c_str());
+      header_printed = true;
+    }
+    for (; header_printed && printed < rows.size(); ++printed)
+      std::printf("%s\n", format_row(rows[printed], check_names.size()).first.c_str());
+    std::fflush(stdout);
+  };
   bool all_ok = true;
   for (std::size_t run = 0; run < runs; ++run) {
     // Mixed-radix digits of `run` pick one value per axis.
     SceneOptions options = base;
     options.out_dir = out_dir / std::to_string(run);
-    std::vector<std::string> picked;
+    SweepRow row;
     for (std::size_t k = 0, rest = run; k < axes.size(); rest /= axes[k].values.size(), ++k) {
-      picked.push_back(axes[k].values[rest % axes[k].values.size()]);
-      options.overrides.push_back(axes[k].key + "=" + picked.back());
+      row.picked.push_back(axes[k].values[rest % axes[k].values.size()]);
+      options.overrides.push_back(axes[k].key + "=" + row.picked.back());
     }
     const auto t0 = std::chrono::steady_clock::now();
-    Scene scene = build_scene(case_file, options);
     RunOptions run_options;
-    run_options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::string status = "ok";
-    RunResult r;
+    row.status = "not built";
     try {
-      r = run_scene(scene, run_options);
-      if (!r.all_checks_passed()) status = "check failed";
+      Scene scene = build_scene(case_file, options);
+      run_options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!columns_known)
+        for (const auto& c : scene.checks) check_names.push_back(c.column);
+      columns_known = true;
+      Json counts = Json::object();
+      if (scene.continuum) scene.continuum->describe(counts);
+      row.particles = scene.dem.particles.size();
+      row.nodes = counts.find("continuum_nodes") ? long(counts.at("continuum_nodes").as_integer()) : 0;
+      row.status = "stopped";
+      const RunResult r = run_scene(scene, run_options);
+      row.steps = r.steps;
+      row.wall = run_options.setup_seconds + r.wall_seconds;
+      for (const auto& c : r.checks) row.checks.emplace_back(c.value, c.relative_error);
+      row.status = r.all_checks_passed() ? "ok" : "check failed";
     } catch (const RunError& e) {
-      status = "stopped";
+      std::fprintf(stderr, "arlequin sweep: run %zu (%s): %s\n", run, options.out_dir.string().c_str(), e.what());
     }
-    all_ok = all_ok && status == "ok";
-    const double wall = run_options.setup_seconds + r.wall_seconds;
-    if (run == 0) {
-      std::string md = "|", rule = "|";
-      for (const auto& a : axes) md += " " + a.key + " |", rule += "---|", header += a.key + ",";
-      md += " DEs | nodes | steps |", rule += "---|---|---|";
-      header += "particles,continuum_nodes,steps,";
-      for (const auto& c : r.checks) {
-        md += " " + c.check->column + " | error |", rule += "---|---|";
-        header += c.check->column + "," + c.check->column + "_relative_error,";
-      }
-      md += " wall s | status |", rule += "---|---|";
-      header += "wall_seconds,status";
-      std::printf("%s\n%s\n", md.c_str(), rule.c_str());
-    }
-    Json counts = Json::object();
-    if (scene.continuum) scene.continuum->describe(counts);
-    const long nodes = counts.find("continuum_nodes") ? long(counts.at("continuum_nodes").as_integer()) : 0;
-    std::string line = "|", row;
-    for (const auto& v : picked) line += " " + v + " |", row += v + ",";
-    char buffer[256];
-    std::snprintf(buffer, sizeof buffer, " %zu | %ld | %ld |", scene.dem.particles.size(), nodes, r.steps);
-    line += buffer;
-    row += std::to_string(scene.dem.particles.size()) + "," + std::to_string(nodes) + "," + std::to_string(r.steps) + ",";
-    for (const auto& c : r.checks) {
-      std::snprintf(buffer, sizeof buffer, " %.6g | %.3g %% |", c.value, 100 * c.relative_error);
-      line += buffer;
-      std::snprintf(buffer, sizeof buffer, "%.9g,%.6g,", c.value, c.relative_error);
-      row += buffer;
-    }
-    std::snprintf(buffer, sizeof buffer, " %.3f | %s |", wall, status.c_str());
-    line += buffer;
-    std::snprintf(buffer, sizeof buffer, "%.6f,%s", wall, status.c_str());
-    row += buffer;
-    std::printf("%s\n", line.c_str());
-    std::fflush(stdout);
-    csv += row + "\n";
+    all_ok = all_ok && row.status == "ok";
+    rows.push_back(std::move(row));
+    print_rows(false);
   }
-  write_file_atomically(out_dir / "sweep.csv", header + "\n" + csv);
+  print_rows(true);
+
+  std::string csv;
+  for (const auto& a : axes) csv += a.key + ",";
+  csv += "particles,continuum_nodes,steps,";
+  for (const auto& c : check_names) csv += c + "," + c + "_relative_error,";
+  csv += "wall_seconds,status\n";
+  std::vector<std::vector<std::string>> picked;
+  std::vector<double> first_value, wall;
+  for (const SweepRow& row : rows) {
+    csv += format_row(row, check_names.size()).second + "\n";
+    if (!row.checks.empty()) {
+      picked.push_back(row.picked);
+      first_value.push_back(row.checks[0].first);
+      wall.push_back(row.wall);
+    }
+  }
+  write_file_atomically(out_dir / "sweep.csv", csv);
+  if (!picked.empty()) plot_sweep(out_dir / "sweep.png", axes, picked, first_value, wall, check_names[0]);
   return all_ok;
 }
 

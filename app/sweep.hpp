@@ -16,11 +16,14 @@ struct SweepAxis {
   std::vector<std::string> values;  // YAML texts
 };
 
-// Parses "key=v1,v2,v3"; InputError naming the option if malformed.
+// Parses "key=v1,v2,v3" (commas inside brackets belong to a value: "key=[1,2],[3,4]");
+// InputError naming the option if malformed.
 SweepAxis parse_sweep_axis(const std::string& text);
 
 // Runs every combination into out_dir/<run index>/, prints a Markdown table on stdout and
-// writes out_dir/sweep.csv (atomically). Returns false if any run failed or missed a check.
+// writes out_dir/sweep.csv (atomically) and sweep.png: the first check's value against the
+// first axis if its values are numbers (a line per combination of the other axes), else
+// against the wall time. Returns false if any run failed or missed a check.
 bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
                const std::vector<SweepAxis>& axes, const std::filesystem::path& out_dir);
 

@@ -32,6 +32,48 @@ struct GmshScope {
   ~GmshScope() { gmsh::finalize(); }
 };
 
+// MeshSource::left_out on the raw arrays; returns the number of tetrahedra dropped.
+int leave_out(int npe, const std::function<bool(const Vec3&)>& left_out, std::vector<Vec3>& nodes,
+              std::vector<int>& tets, std::vector<PhysicalGroup>& groups) {
+  const int ntet = static_cast<int>(tets.size()) / npe;
+  std::vector<int> new_tet(ntet, -1), new_node(nodes.size(), -1);
+  std::vector<int> kept_tets;
+  std::vector<Vec3> kept_nodes;
+  for (int e = 0; e < ntet; ++e) {
+    const int* t = tets.data() + static_cast<std::size_t>(e) * npe;
+    if (std::all_of(t, t + 4, [&](int n) { return left_out(nodes[n]); })) continue;
+    new_tet[e] = static_cast<int>(kept_tets.size()) / npe;
+    for (int k = 0; k < npe; ++k) {
+      if (new_node[t[k]] < 0) {
+        new_node[t[k]] = static_cast<int>(kept_nodes.size());
+        kept_nodes.push_back(nodes[t[k]]);
+      }
+      kept_tets.push_back(new_node[t[k]]);
+    }
+  }
+  const int dropped = ntet - static_cast<int>(kept_tets.size()) / npe;
+  if (dropped == 0) return 0;
+  std::vector<PhysicalGroup> kept_groups;
+  for (PhysicalGroup& g : groups) {
+    std::vector<int> group_nodes, group_tets;
+    std::vector<std::array<int, 3>> triangles;
+    for (int n : g.nodes)
+      if (new_node[n] >= 0) group_nodes.push_back(new_node[n]);
+    for (int e : g.tets)
+      if (new_tet[e] >= 0) group_tets.push_back(new_tet[e]);
+    for (const auto& f : g.triangles)
+      if (new_node[f[0]] >= 0 && new_node[f[1]] >= 0 && new_node[f[2]] >= 0)
+        triangles.push_back({new_node[f[0]], new_node[f[1]], new_node[f[2]]});
+    std::sort(group_nodes.begin(), group_nodes.end());
+    if (group_nodes.empty() || (g.dim == 3 && group_tets.empty()) || (g.dim == 2 && triangles.empty())) continue;
+    kept_groups.push_back({g.name, g.dim, std::move(group_nodes), std::move(triangles), std::move(group_tets)});
+  }
+  nodes = std::move(kept_nodes);
+  tets = std::move(kept_tets);
+  groups = std::move(kept_groups);
+  return dropped;
+}
+
 }  // namespace
 
 Mesh Mesh::load(const MeshSource& source) {
@@ -151,7 +193,14 @@ Mesh Mesh::load(const MeshSource& source) {
       std::copy(edge.begin(), edge.end(), t + 4);
     }
   }
-  return Mesh(order, std::move(nodes), std::move(tets), std::move(groups));
+  int dropped = 0;
+  if (source.left_out) {
+    dropped = leave_out(npe, source.left_out, nodes, tets, groups);
+    if (tets.empty()) throw InputError(source.path + ": every tetrahedron lies in the left-out region (the pure-DEM zone)");
+  }
+  Mesh mesh(order, std::move(nodes), std::move(tets), std::move(groups));
+  mesh.tets_left_out_ = dropped;
+  return mesh;
 }
 
 Mesh::Mesh(int order, std::vector<Vec3> nodes, std::vector<int> tets, std::vector<PhysicalGroup> groups)

@@ -5,10 +5,14 @@
 //  - Tetrahedra are stored with positive volume, vertices first; quadratic tetrahedra are
 //    renumbered to the fixed edge order of `kTetEdges` (gmsh's own order is not assumed: every
 //    edge node is matched to the midpoint of its two vertices, which also rejects curved P2).
+//  - `MeshSource::left_out` (optional) drops every tetrahedron whose vertices all satisfy it
+//    (an Arlequin coupling's pure-DEM zone), then the nodes only those used; physical groups
+//    keep what remains of them, and a group with nothing left is dropped.
 //  - Problems are InputError: unreadable file, no tetrahedra, inverted or flat tetrahedron,
 //    empty physical group, unknown group name (the message lists the known ones).
 #pragma once
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,6 +24,7 @@ struct MeshSource {
   std::string path;   // .geo (meshed here) or .msh
   double size = 0.0;  // target element size for .geo; 0 keeps the sizes written in the file
   int order = 1;      // 1 or 2, for .geo
+  std::function<bool(const Vec3&)> left_out;  // optional: see the contract
 };
 
 // Edge k of a tetrahedron joins vertices kTetEdges[k]; node 4+k of a P2 tetrahedron sits on it.
@@ -53,12 +58,14 @@ class Mesh {
   const PhysicalGroup& group(const std::string& name) const;  // InputError if unknown
   // Triangles (vertex triples) on the outer boundary: faces owned by one tetrahedron only.
   std::vector<std::array<int, 3>> boundary_triangles() const;
+  int tets_left_out() const { return tets_left_out_; }  // by MeshSource::left_out
 
  private:
   int order_;
   std::vector<Vec3> nodes_;
   std::vector<int> tets_;
   std::vector<PhysicalGroup> groups_;
+  int tets_left_out_ = 0;
 };
 
 }  // namespace arlequin::continuum

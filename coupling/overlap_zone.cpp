@@ -52,6 +52,9 @@ OverlapZone::OverlapZone(const Region& region, RampCoordinate ramp, Weighting we
     : OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting,
                   region.describe()) {}
 
+bool OverlapZone::in_dem_domain(const Vec3& x) const { return ramp_(x) <= 1.0 + kRampTolerance; }
+bool OverlapZone::in_pure_dem_zone(const Vec3& x) const { return ramp_(x) <= kRampTolerance; }
+
 double OverlapZone::alpha_d(const Vec3& x) const {
   const double s = ramp_(x);
   if (s < -kRampTolerance) return 1.0;

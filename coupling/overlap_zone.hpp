@@ -13,7 +13,9 @@
 //    so no DE has a zero mass at the continuum-side edge. Stiffness is never floored.
 //  - contains(x): x in the overlap (its boundaries included, relative tolerance 1e-9), which is
 //    where DEs are coupled. DEs beyond the overlap on the continuum side (alpha_d = 0) must not
-//    exist: their bonds would carry no stiffness and nothing would hold them.
+//    exist: their bonds would carry no stiffness and nothing would hold them. in_dem_domain(x)
+//    (s <= 1) is where DEs may be; in_pure_dem_zone(x) (s <= 0) is where a continuum
+//    tetrahedron with all its vertices there has alpha_c = 0 throughout and is left out.
 //  - Shapes: a box slab (ramp along one axis), a finite cylinder (ramp along its axis), the shell
 //    between two nested boxes (DEM inside the inner box, continuum outside the outer one), or
 //    any common Region with a caller-given ramp coordinate (sphere, half-space, ...).
@@ -59,6 +61,8 @@ class OverlapZone {
 
   bool contains(const Vec3& x) const { return contains_(x); }
   double ramp(const Vec3& x) const { return ramp_(x); }
+  bool in_dem_domain(const Vec3& x) const;
+  bool in_pure_dem_zone(const Vec3& x) const;
   double alpha_d(const Vec3& x) const;
   double alpha_c(const Vec3& x) const { return 1.0 - alpha_d(x); }
   double mass_floor() const { return weighting_.mass_floor; }

@@ -1,7 +1,8 @@
 // Spherical discrete elements in structure-of-arrays form.
 //
-// Contract: every array has size(); index i is one DE for the whole run (DEs are never
-// reordered or removed, so bond and group indices stay valid). Orientation q maps body to
+// Contract: every array has size(); index i is one DE for the whole run (once bonds or groups
+// refer to DEs they are never reordered or removed, so those indices stay valid; `keep_only`
+// is for a sample being built). Orientation q maps body to
 // world frame; angular velocity omega is in the world frame. Inertia is the sphere's
 // I = 2/5 m R^2, isotropic, so Euler's equations reduce to d(omega)/dt = torque / I.
 #pragma once
@@ -41,6 +42,24 @@ struct ParticleSet {
   double inertia(std::size_t i) const { return 1.0 / inv_inertia(i); }
   void clear_forces();
   void reserve(std::size_t n);
+  // Drops every DE i with keep(i) false, keeping the order of the others; returns how many
+  // were dropped. Only before bonds, groups or boundary conditions refer to DE indices.
+  template <class Keep>
+  std::size_t keep_only(Keep keep);
+
+ private:
+  void move_entry(std::size_t from, std::size_t to);
+  void resize(std::size_t n);
 };
+
+template <class Keep>
+std::size_t ParticleSet::keep_only(Keep keep) {
+  const std::size_t n = size();
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (keep(i)) move_entry(i, kept++);
+  resize(kept);
+  return n - kept;
+}
 
 }  // namespace arlequin::dem

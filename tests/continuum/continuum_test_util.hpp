@@ -11,7 +11,7 @@ inline std::string mesh_path(const std::string& name) { return std::string(ARLEQ
 
 inline ContinuumSettings settings(const std::string& mesh, double size, int order, const Material& m) {
   ContinuumSettings s;
-  s.mesh = {mesh_path(mesh), size, order};
+  s.mesh = {mesh_path(mesh), size, order, {}};
   s.materials = {{"", m}};
   return s;
 }

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "common/error.hpp"
 #include "continuum/mesh.hpp"
 #include "continuum_test_util.hpp"
@@ -9,7 +11,7 @@ using namespace arlequin::continuum;
 using arlequin::continuum::testing::mesh_path;
 
 TEST(ContinuumMesh, GeoIsMeshedWithNamedGroups) {
-  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1});
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1, {}});
   EXPECT_EQ(m.order(), 1);
   EXPECT_NEAR(m.volume(), 1.0, 1e-12);
   EXPECT_EQ(m.group("domain").dim, 3);
@@ -20,7 +22,7 @@ TEST(ContinuumMesh, GeoIsMeshedWithNamedGroups) {
 }
 
 TEST(ContinuumMesh, QuadraticEdgeNodesAreMidpoints) {
-  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 2});
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 2, {}});
   ASSERT_EQ(m.order(), 2);
   for (int e = 0; e < m.num_tets(); ++e)
     for (int k = 0; k < 6; ++k) {
@@ -29,15 +31,47 @@ TEST(ContinuumMesh, QuadraticEdgeNodesAreMidpoints) {
     }
 }
 
+// An Arlequin cut (MeshSource::left_out, here x <= 0.5): exactly the tetrahedra with all four
+// vertices in x <= 0.5 go, with the nodes only they used; the groups keep what is left of them
+// and xmin, wholly in the cut, is dropped. The kept volume is the tetrahedra's, counted apart.
+TEST(ContinuumMesh, LeftOutRegionCutsTetrahedraNodesAndGroups) {
+  for (int order : {1, 2}) {
+    const Mesh full = Mesh::load({mesh_path("unit_cube.geo"), 0.25, order, {}});
+    const auto cut = [](const Vec3& x) { return x.x <= 0.5 + 1e-12; };
+    const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.25, order, cut});
+    int dropped = 0;
+    double kept_volume = 0.0;
+    for (int e = 0; e < full.num_tets(); ++e) {
+      const int* t = full.tet(e);
+      if (cut(full.nodes()[t[0]]) && cut(full.nodes()[t[1]]) && cut(full.nodes()[t[2]]) && cut(full.nodes()[t[3]]))
+        ++dropped;
+      else
+        kept_volume += full.tet_volume(e);
+    }
+    ASSERT_GT(dropped, 0);
+    EXPECT_EQ(m.tets_left_out(), dropped);
+    EXPECT_EQ(m.num_tets(), full.num_tets() - dropped);
+    EXPECT_NEAR(m.volume(), kept_volume, 1e-12);
+    std::vector<char> used(m.num_nodes(), 0);
+    for (int e = 0; e < m.num_tets(); ++e)
+      for (int k = 0; k < m.nodes_per_tet(); ++k) used[m.tet(e)[k]] = 1;
+    EXPECT_EQ(std::count(used.begin(), used.end(), 1), m.num_nodes());  // no orphan node
+    EXPECT_FALSE(m.has_group("xmin"));
+    EXPECT_EQ(m.group("xmax").nodes.size(), full.group("xmax").nodes.size());
+    EXPECT_EQ(static_cast<int>(m.group("domain").tets.size()), m.num_tets());
+    EXPECT_LT(m.group("ymin").triangles.size(), full.group("ymin").triangles.size());
+  }
+}
+
 TEST(ContinuumMesh, ProblemsAreClearErrors) {
-  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1});
+  const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1, {}});
   try {
     m.group("nonexistent");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("xmin"), std::string::npos);  // lists the known names
   }
-  EXPECT_THROW(Mesh::load({mesh_path("no_such_mesh.geo"), 0.5, 1}), InputError);
+  EXPECT_THROW(Mesh::load({mesh_path("no_such_mesh.geo"), 0.5, 1, {}}), InputError);
   // Inverted tetrahedron.
   std::vector<Vec3> x{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   EXPECT_NO_THROW(Mesh(1, x, {0, 1, 2, 3}, {}));

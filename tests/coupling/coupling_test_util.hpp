@@ -90,7 +90,7 @@ inline std::string write_box_mesh(const std::string& name, double x0, int nx, do
 inline std::unique_ptr<continuum::ContinuumSolver> make_continuum(const std::string& method, const std::string& mesh,
                                                                   double E, double nu, double rho) {
   continuum::ContinuumSettings s;
-  s.mesh = {mesh, 0.0, 1};
+  s.mesh = {mesh, 0.0, 1, {}};
   s.materials = {{"", continuum::Material::isotropic(E, nu, rho)}};
   return continuum::make_continuum_solver(method, s);
 }

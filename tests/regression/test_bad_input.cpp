@@ -87,6 +87,8 @@ INSTANTIATE_TEST_SUITE_P(
                  {"case.yaml:6", "dem.bond.r_mu"}},
         BadInput{"unknown_sensor_type", 14, "  - {name: F, type: forse, group: right}", "",
                  {"case.yaml:14", "sensors[0].type", "did you mean 'force'"}},
+        BadInput{"affine_deviation_without_initial_strain", 14, "  - {name: d, type: affine_deviation}", "",
+                 {"case.yaml:14", "sensors[0].type", "needs an initial_strain section"}},
         BadInput{"unknown_output_field", 15, "output: {fields: [particle]}", "",
                  {"case.yaml:15", "output.fields", "particle"}},
         BadInput{"duplicate_group", 9, "  - {name: left, region: {box: [[-1, -1, -1], [1, 1, 1]]}}", "",

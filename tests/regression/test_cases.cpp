@@ -6,6 +6,7 @@
 
 #include "app/runner.hpp"
 #include "app/scene.hpp"
+#include "app/sweep.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
 #include "support/cli.hpp"
@@ -99,6 +100,37 @@ TEST(Cli, SweepTabulatesErrorAgainstRunTime) {
   EXPECT_NE(csv.find("continuum.mesh.size,particles,continuum_nodes,steps,tip_deflection,tip_deflection_relative_error,wall_seconds,status"),
             std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+  EXPECT_TRUE(std::filesystem::exists(out / "sweep.png"));
+}
+
+// Sweep values split at commas outside brackets, so a box or a vector can be swept.
+TEST(Cli, SweepAxisValuesMayBeLists) {
+  const app::SweepAxis box = app::parse_sweep_axis("coupling.overlap.box=[[0,0,0],[1,1,1]],[[0,0,0],[2,1,1]]");
+  EXPECT_EQ(box.key, "coupling.overlap.box");
+  EXPECT_EQ(box.values, (std::vector<std::string>{"[[0,0,0],[1,1,1]]", "[[0,0,0],[2,1,1]]"}));
+  EXPECT_EQ(app::parse_sweep_axis("a.b=1,2,3").values, (std::vector<std::string>{"1", "2", "3"}));
+  EXPECT_THROW(app::parse_sweep_axis("a=[1,2"), InputError);
+  EXPECT_THROW(app::parse_sweep_axis("a=1]"), InputError);
+}
+
+// The static patch test as a case (R6, last line): the start is exact to round-off; the ghost
+// forces of a 5 x 5 lattice against P1 nodal shares then stay at the measured level (the
+// case's check; R6's 1e-10 is not met, README).
+TEST(Cases, PatchCoupledStartsExactAndBoundsTheGhostForces) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("patch_coupled");
+  const auto r = test::run_arlequin("run " + cases + "patch_coupled/case.yaml --quiet --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_TRUE(s.at("checks").as_array().at(0).at("passed").as_bool());
+  const std::string csv = test::read_text(out / "series.csv");
+  const auto second_line = csv.find('\n') + 1;
+  const std::string first_row = csv.substr(second_line, csv.find('\n', second_line) - second_line);
+  // time, step, deviation, ...: the deviation at t = 0 is round-off of eps X.
+  const auto c1 = first_row.find(','), c2 = first_row.find(',', c1 + 1), c3 = first_row.find(',', c2 + 1);
+  EXPECT_LT(std::stod(first_row.substr(c2 + 1, c3 - c2 - 1)), 1e-12) << first_row;
 }
 
 // BBF in a structure: a simple-cubic lattice bar fails at 36 S sigma_f (the case's own check),
@@ -129,6 +161,12 @@ TEST(Cases, WaveBarCoupledTransmitsThePulse) {
   // Default (h = 4a, lambda = 1.6 lambda_c): the case's own check, R <= 0.5 %.
   const Json coarse = run_case("wave_bar_coupled");
   EXPECT_TRUE(coarse.at("checks").as_array().at(0).at("passed").as_bool());
+  // The lattice (119 x 5 x 5) covers the whole bar; the overlap 22a..30a cuts it: DEs up to
+  // x = 30a (31 x 25) are created. The mesh starts at 22a: nothing of it is left out.
+  const Json& counts = coarse.at("counts");
+  EXPECT_EQ(counts.at("particles").as_integer(), 31 * 25);
+  EXPECT_EQ(counts.at("particles_not_created").as_integer(), 88 * 25);
+  EXPECT_EQ(counts.find("continuum_tetrahedra_left_out"), nullptr);
   // Matched (h = a), lambda = 20a >= 5a: R <= 0.3 %.
   const Json matched = run_case("wave_bar_coupled", "--set continuum.mesh.file=../../meshes/coupled_bar_h1.geo");
   EXPECT_LE(matched.at("checks").as_array().at(0).at("value").as_number(), 0.003);

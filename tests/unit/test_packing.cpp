@@ -252,5 +252,31 @@ TEST(ValidationPacking, FortyThousandDesInABox) {
   EXPECT_LT(report.seconds, 300.0);
 }
 
+// keep_only (a coupled sample cut to its DEM domain): the kept DEs, in order, with all their
+// state; the others gone from every array.
+TEST(Samples, KeepOnlyDropsDesAndKeepsTheOthersInOrder) {
+  ParticleSet p;
+  build_lattice(p, {0, 0, 0}, {6, 1, 1}, 2.0, 1.0, 1000.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.velocity[i] = {double(i), 0, 0};
+    p.radius[i] = 1.0 + 0.1 * double(i);
+    p.groups[i] = GroupMask(1u << i);
+  }
+  const std::size_t dropped = p.keep_only([&](std::size_t i) { return i % 2 == 1; });
+  EXPECT_EQ(dropped, 3u);
+  ASSERT_EQ(p.size(), 3u);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const std::size_t i = 2 * k + 1;
+    EXPECT_EQ(p.position[k].x, 2.0 * double(i));
+    EXPECT_EQ(p.reference[k].x, 2.0 * double(i));
+    EXPECT_EQ(p.velocity[k].x, double(i));
+    EXPECT_EQ(p.radius[k], 1.0 + 0.1 * double(i));
+    EXPECT_EQ(p.groups[k], GroupMask(1u << i));
+  }
+  for (std::size_t n : {p.reference.size(), p.velocity.size(), p.orientation.size(), p.angular_velocity.size(),
+                        p.force.size(), p.torque.size(), p.radius.size(), p.inv_mass.size(), p.groups.size()})
+    EXPECT_EQ(n, 3u);
+}
+
 }  // namespace
 }  // namespace arlequin::dem

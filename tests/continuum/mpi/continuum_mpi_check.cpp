@@ -20,7 +20,7 @@ using namespace arlequin::continuum;
 
 int main() {
   ContinuumSettings settings;
-  settings.mesh = {std::string(ARLEQUIN_SOURCE_DIR) + "/meshes/cantilever.geo", 0.25, 1};
+  settings.mesh = {std::string(ARLEQUIN_SOURCE_DIR) + "/meshes/cantilever.geo", 0.25, 1, {}};
   settings.materials = {{"", Material::isotropic(1000.0, 0.3, 1.0)}};
   auto s = make_continuum_solver("fe", settings);  // starts PETSc, hence MPI
   int rank, size;
