@@ -166,14 +166,14 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
     op.Gd = S;
     op.Gc = -(S * op.N);
   } else {
-    // Mediator nodes: continuum nodes whose shape function is seen by the DE quadrature.
+    // Mediator nodes: continuum nodes of the overlap whose shape function the DE quadrature sees.
     Eigen::VectorXd seen = Eigen::VectorXd::Zero(nn);
     for (int q = 0; q < np; ++q)
       for (SparseMatrix::InnerIterator it(op.N, q); it; ++it) seen[it.col()] += op.weight[q] * std::abs(it.value());
     const double tol = 1e-12 * seen.maxCoeff();
     std::vector<Triplet> t;
     for (int I = 0; I < nn; ++I)
-      if (seen[I] > tol) {
+      if (seen[I] > tol && zone.contains(continuum.nodes()[I])) {
         t.emplace_back(static_cast<int>(op.mediator_nodes.size()), I, 1.0);
         op.mediator_nodes.push_back(I);
       }

@@ -17,8 +17,11 @@
 //    (sum_j d_j d_j^T)^+, d_j = x_j - x_p over coupled DEs within gradient_radius (exact for
 //    affine fields). The continuum field enters through its values at the DEs, N u_c.
 //  - Mediator space (where the multiplier lambda lives), both fields tested against it:
-//      coarse (default): lambda = sum_I N_I lambda_I over the continuum nodes that carry DEs
-//             (rows = mediator_nodes):   G_d = N^T S,   G_c = -N^T S N
+//      coarse (default): lambda = sum_I N_I lambda_I over the continuum nodes of the overlap
+//             (closed) that carry DEs (rows = mediator_nodes):   G_d = N^T S,   G_c = -N^T S N.
+//             A natural-neighbour node beyond the overlap can still carry a DE on its edge
+//             (Sibson support reaches past the next node plane) but only weakly: as a mediator
+//             row it made A near-singular (NEM, h = 2a), so it is not one.
 //      fine:  lambda at every coupled DE (rows = particles):  G_d = S,  G_c = -S N
 //    Columns of G_d: coupled DEs (order of `particles`); columns of G_c: all continuum nodes.
 //    The operators are scalar and act on x, y and z alike. For the fine mediator S is

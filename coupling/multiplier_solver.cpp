@@ -1,5 +1,6 @@
 #include "coupling/multiplier_solver.hpp"
 
+#include <sstream>
 #include <string>
 
 #include "common/error.hpp"
@@ -32,16 +33,20 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     auto f = std::make_unique<Factor>();
     f->compute(Acol);
     bool ok = f->info() == Eigen::Success;
+    double dmin = 0.0, dmax = 0.0;
     if (ok) {
       const Eigen::VectorXd D = f->vectorD();
-      const double dmax = D.cwiseAbs().maxCoeff();
-      ok = D.minCoeff() > 1e-13 * dmax;
+      dmax = D.cwiseAbs().maxCoeff();
+      dmin = D.minCoeff();
+      ok = dmin > 1e-13 * dmax;
     }
-    if (!ok)
-      throw RunError("coupling: the multiplier matrix A (" + std::to_string(ops.rows()) +
-                     " rows) is not positive definite; with the coarse mediator every continuum element "
-                     "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, "
-                     "or mediator: fine)");
+    if (!ok) {
+      std::ostringstream msg;
+      msg << "coupling: the multiplier matrix A (" << ops.rows() << " rows, component " << "xyz"[c] << ", LDL^T pivots "
+          << dmin << " to " << dmax << ") is not positive definite; with the coarse mediator every continuum element "
+          << "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, or mediator: fine)";
+      throw RunError(msg.str());
+    }
     factor_of_[c] = static_cast<int>(factors_.size());
     diagonals_.push_back(f->vectorD());
     factors_.push_back(std::move(f));
