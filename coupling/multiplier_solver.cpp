@@ -28,11 +28,17 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     const Eigen::VectorXd md = inv_d_.col(c), mc = inv_c_.col(c);
     const SparseMatrix A = ops.Gd * md.asDiagonal() * SparseMatrix(ops.Gd.transpose()) +
                            ops.Gc * mc.asDiagonal() * SparseMatrix(ops.Gc.transpose());
-    Eigen::SparseMatrix<double> Acol = A;  // column-major for the Cholesky factor
+    // Jacobi scaling S A S, S = diag(A)^-1/2: rows of A differ by orders of magnitude (a
+    // floored continuum mass on the overlap edge against a full one), and the pivot test below
+    // is only meaningful on a unit diagonal.
+    Eigen::VectorXd scale = A.diagonal();
+    bool ok = scale.minCoeff() > 0.0;
+    if (ok) scale = scale.cwiseSqrt().cwiseInverse();
+    Eigen::SparseMatrix<double> Acol = scale.asDiagonal() * A * scale.asDiagonal();  // column-major for the factor
     nonzeros_ = Acol.nonZeros();
     auto f = std::make_unique<Factor>();
-    f->compute(Acol);
-    bool ok = f->info() == Eigen::Success;
+    if (ok) f->compute(Acol);
+    ok = ok && f->info() == Eigen::Success;
     double dmin = 0.0, dmax = 0.0;
     if (ok) {
       const Eigen::VectorXd D = f->vectorD();
@@ -42,29 +48,32 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     }
     if (!ok) {
       std::ostringstream msg;
-      msg << "coupling: the multiplier matrix A (" << ops.rows() << " rows, component " << "xyz"[c] << ", LDL^T pivots "
+      msg << "coupling: the multiplier matrix A (" << ops.rows() << " rows, component " << "xyz"[c] << ", LDL^T pivots of the Jacobi-scaled A "
           << dmin << " to " << dmax << ") is not positive definite; with the coarse mediator every continuum element "
           << "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, or mediator: fine)";
       throw RunError(msg.str());
     }
     factor_of_[c] = static_cast<int>(factors_.size());
     diagonals_.push_back(f->vectorD());
+    scales_.push_back(scale);
     factors_.push_back(std::move(f));
   }
 }
 
-// The factor's solve spelled out, P^T L D L^T P lambda = rhs: Eigen's own applies the inverse
-// permutation in place, which allocates a mask each call.
+// The factor's solve spelled out, S P^T L D L^T P S lambda = rhs with the Jacobi scaling S:
+// Eigen's own applies the inverse permutation in place, which allocates a mask each call.
 void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
   lambda.resize(rhs.rows(), 3);
   for (int c = 0; c < 3; ++c) {
-    const Factor& f = *factors_[factor_of_[c]];
-    column_ = rhs.col(c);
+    const int k = factor_of_[c];
+    const Factor& f = *factors_[k];
+    column_ = rhs.col(c).cwiseProduct(scales_[k]);
     solution_ = f.permutationP() * column_;
     f.matrixL().solveInPlace(solution_);
-    solution_.array() /= diagonals_[factor_of_[c]].array();
+    solution_.array() /= diagonals_[k].array();
     f.matrixU().solveInPlace(solution_);
-    lambda.col(c) = f.permutationPinv() * solution_;
+    column_ = f.permutationPinv() * solution_;
+    lambda.col(c) = column_.cwiseProduct(scales_[k]);
   }
 }
 

@@ -53,6 +53,7 @@ class MultiplierSolver {
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
   std::vector<std::unique_ptr<Factor>> factors_;
   std::vector<Eigen::VectorXd> diagonals_;     // D of each factor
+  std::vector<Eigen::VectorXd> scales_;        // Jacobi scaling diag(A)^-1/2 of each factor
   std::array<int, 3> factor_of_{0, 0, 0};      // component -> factor
   long nonzeros_ = 0;
   mutable Matrix3 rhs_;                        // scratch: the residual to project

@@ -59,7 +59,10 @@ double OverlapZone::alpha_d(const Vec3& x) const {
   const double s = ramp_(x);
   if (s < -kRampTolerance) return 1.0;
   if (s > 1.0 + kRampTolerance) return 0.0;
-  const double t = std::clamp(s, 0.0, 1.0);
+  // On a boundary within the tolerance, exactly on it: a node at x = 22a that gmsh places at
+  // 22a (1 + 1e-16) must get alpha_c = 0, not 1e-14 (a natural-neighbour node mass of 1e-14 of
+  // its cell's took the critical step down to 1e-13 s).
+  const double t = s <= kRampTolerance ? 0.0 : s >= 1.0 - kRampTolerance ? 1.0 : s;
   switch (weighting_.shape) {
     case WeightShape::constant: return weighting_.constant_value;
     case WeightShape::linear: return 1.0 - t;

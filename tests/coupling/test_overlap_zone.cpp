@@ -29,6 +29,26 @@ TEST(CouplingOverlapZone, BoxSlabWeights) {
   EXPECT_DOUBLE_EQ(con.alpha_d({6.5, 0.5, 0.5}), 1.0);
 }
 
+// A point a round-off away from an overlap face (a mesh node at 2 (1 + 1e-16)) gets the weight
+// of the face exactly: alpha_c = 0 on the DEM-side face, not 1e-16 (a natural-neighbour node
+// mass that small once took the coupled critical step down to 1e-13 s). Domain tests agree.
+TEST(CouplingOverlapZone, RoundOffOffAFaceGetsTheFaceWeight) {
+  const Box b{{0.044, 0, 0}, {0.060, 1, 1}};
+  for (WeightShape shape : {WeightShape::linear, WeightShape::cubic}) {
+    const OverlapZone z = OverlapZone::box(b, 0, true, {shape, 0.05, 0.5});
+    for (double x : {0.044 * (1 + 2e-16), 0.044 * (1 - 2e-16), 0.004 + 5 * 0.008}) {
+      EXPECT_EQ(z.alpha_c({x, 0.5, 0.5}), 0.0) << x;
+      EXPECT_TRUE(z.in_pure_dem_zone({x, 0.5, 0.5})) << x;
+    }
+    for (double x : {0.060 * (1 + 2e-16), 0.060 * (1 - 2e-16)}) {
+      EXPECT_EQ(z.alpha_d({x, 0.5, 0.5}), 0.0) << x;
+      EXPECT_TRUE(z.in_dem_domain({x, 0.5, 0.5})) << x;
+    }
+    EXPECT_FALSE(z.in_dem_domain({0.0601, 0.5, 0.5}));
+    EXPECT_FALSE(z.in_pure_dem_zone({0.0441, 0.5, 0.5}));
+  }
+}
+
 TEST(CouplingOverlapZone, ShellAndCylinder) {
   const OverlapZone shell = OverlapZone::shell({{-1, -1, -1}, {1, 1, 1}}, {{-3, -2, -1}, {3, 2, 1}}, {});
   EXPECT_DOUBLE_EQ(shell.alpha_d({0, 0, 0}), 1.0);

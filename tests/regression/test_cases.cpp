@@ -161,12 +161,13 @@ TEST(Cases, WaveBarCoupledTransmitsThePulse) {
   // Default (h = 4a, lambda = 1.6 lambda_c): the case's own check, R <= 0.5 %.
   const Json coarse = run_case("wave_bar_coupled");
   EXPECT_TRUE(coarse.at("checks").as_array().at(0).at("passed").as_bool());
-  // The lattice (119 x 5 x 5) covers the whole bar; the overlap 22a..30a cuts it: DEs up to
-  // x = 30a (31 x 25) are created. The mesh starts at 22a: nothing of it is left out.
+  // The lattice (119 x 5 x 5) and the mesh (x >= 2a) cover the bar; the overlap 22a..30a cuts
+  // them: DEs up to x = 30a (31 x 25), tetrahedra from 22a on (5 elements of h = 4a, 6 each, go).
   const Json& counts = coarse.at("counts");
   EXPECT_EQ(counts.at("particles").as_integer(), 31 * 25);
   EXPECT_EQ(counts.at("particles_not_created").as_integer(), 88 * 25);
-  EXPECT_EQ(counts.find("continuum_tetrahedra_left_out"), nullptr);
+  EXPECT_EQ(counts.at("continuum_tetrahedra_left_out").as_integer(), 5 * 6);
+  EXPECT_EQ(counts.at("continuum_nodes").as_integer(), 25 * 4);
   // Matched (h = a), lambda = 20a >= 5a: R <= 0.3 %.
   const Json matched = run_case("wave_bar_coupled", "--set continuum.mesh.file=../../meshes/coupled_bar_h1.geo");
   EXPECT_LE(matched.at("checks").as_array().at(0).at("value").as_number(), 0.003);
