@@ -84,8 +84,10 @@ class Part final : public ContinuumPart {
   void set_affine_displacement(const std::array<Vec3, 3>& H) override {
     auto& u = solver_->displacement();
     const auto& x = solver_->nodes();
-    for (std::size_t n = 0; n < x.size(); ++n)
-      for (int c = 0; c < 3; ++c) u[3 * n + c] = dot(H[c], x[n]);
+    for (std::size_t n = 0; n < x.size(); ++n) {
+      const Vec3 hx = rows_times(H, x[n]);
+      for (int c = 0; c < 3; ++c) u[3 * n + c] = hx[c];
+    }
   }
   std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
   double coupling_work() const override { return coupled_ ? coupled_->energies().coupling_work : 0.0; }
@@ -110,7 +112,7 @@ class Part final : public ContinuumPart {
     std::array<double, 2> out{0.0, 0.0};
     const auto& X = solver_->nodes();
     for (std::size_t n = 0; n < X.size(); ++n) {
-      const Vec3 affine{dot(H[0], X[n]), dot(H[1], X[n]), dot(H[2], X[n])};
+      const Vec3 affine = rows_times(H, X[n]);
       out[0] = std::max(out[0], norm(node_vector(solver_->displacement(), int(n)) - affine));
       out[1] = std::max(out[1], norm(affine));
     }

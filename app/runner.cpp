@@ -154,7 +154,7 @@ class Outputs {
     const dem::ParticleSet& p = scene_.dem.particles;
     for (std::size_t i = 0; i < p.size(); ++i) {
       const Vec3& X = p.reference[i];
-      const Vec3 affine{dot(H[0], X), dot(H[1], X), dot(H[2], X)};
+      const Vec3 affine = rows_times(H, X);
       m[0] = std::max(m[0], norm(p.position[i] - X - affine));
       m[1] = std::max(m[1], norm(affine));
     }

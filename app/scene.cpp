@@ -374,7 +374,7 @@ void read_initial_strain(CaseNode root, Scene& scene) {
   if (rows.size() != 3) section->fail("gradient", "expected three rows [[..], [..], [..]] of the displacement gradient");
   section->finish();
   const std::array<Vec3, 3> H{rows[0], rows[1], rows[2]};
-  for (Vec3& x : scene.dem.particles.position) x += Vec3{dot(H[0], x), dot(H[1], x), dot(H[2], x)};
+  for (Vec3& x : scene.dem.particles.position) x += rows_times(H, x);
   if (scene.continuum) scene.continuum->set_affine_displacement(H);
   scene.initial_gradient = H;
 }

@@ -3,9 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <cmath>
 #include <cstdio>
-#include <sstream>
 
 #include "app/runner.hpp"
 #include "common/atomic_file.hpp"
@@ -75,10 +73,6 @@ void plot_sweep(const std::filesystem::path& file, const std::vector<SweepAxis>&
   write_png_plot(file, spec);
 }
 
-}  // namespace
-
-namespace {
-
 struct SweepRow {
   std::vector<std::string> picked;  // one value per axis
   std::size_t particles = 0;
@@ -87,6 +81,17 @@ struct SweepRow {
   double wall = 0.0;
   std::string status;
 };
+
+// The Markdown header (names and rule lines) and the CSV header.
+std::pair<std::string, std::string> format_header(const std::vector<SweepAxis>& axes,
+                                                  const std::vector<std::string>& check_names) {
+  std::string md = "|", rule = "|", csv;
+  for (const auto& a : axes) md += " " + a.key + " |", rule += "---|", csv += a.key + ",";
+  md += " DEs | nodes | steps |", rule += "---|---|---|", csv += "particles,continuum_nodes,steps,";
+  for (const auto& c : check_names) md += " " + c + " | error |", rule += "---|---|", csv += c + "," + c + "_relative_error,";
+  md += " wall s | status |", rule += "---|---|", csv += "wall_seconds,status";
+  return {md + "\n" + rule, csv};
+}
 
 // One Markdown line and one CSV row; a run that never got to its checks shows "-" there.
 std::pair<std::string, std::string> format_row(const SweepRow& row, std::size_t num_checks) {
@@ -127,12 +132,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
   // could be built); a run whose scene could not be built still gets its row.
   const auto print_rows = [&](bool final) {
     if (!header_printed && (columns_known || final)) {
-      std::string md = "|", rule = "|";
-      for (const auto& a : axes) md += " " + a.key + " |", rule += "---|";
-      md += " DEs | nodes | steps |", rule += "---|---|---|";
-      for (const auto& c : check_names) md += " " + c + " | error |", rule += "---|---|";
-      md += " wall s | status |", rule += "---|---|";
-      std::printf("%s\n%s\n", md.c_str(), rule.c_str());
+      std::printf("%s\n", format_header(axes, check_names).first.c_str());
       header_printed = true;
     }
     for (; header_printed && printed < rows.size(); ++printed)
@@ -177,11 +177,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
   }
   print_rows(true);
 
-  std::string csv;
-  for (const auto& a : axes) csv += a.key + ",";
-  csv += "particles,continuum_nodes,steps,";
-  for (const auto& c : check_names) csv += c + "," + c + "_relative_error,";
-  csv += "wall_seconds,status\n";
+  std::string csv = format_header(axes, check_names).second + "\n";
   std::vector<std::vector<std::string>> picked;
   std::vector<double> first_value, wall;
   for (const SweepRow& row : rows) {

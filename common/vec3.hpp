@@ -1,6 +1,7 @@
 // Small fixed-size vector and its inline algebra. Plain aggregate so arrays of Vec3 are
 // contiguous (3 doubles each) and the compiler vectorises loops over them.
 #pragma once
+#include <array>
 #include <cmath>
 
 namespace arlequin {
@@ -30,6 +31,10 @@ constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
 constexpr double norm2(const Vec3& a) { return dot(a, a); }
 inline double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
 inline Vec3 normalized(const Vec3& a) { return a / norm(a); }
+// A 3x3 matrix given by its rows (e.g. a displacement gradient H) times x: H x.
+constexpr Vec3 rows_times(const std::array<Vec3, 3>& rows, const Vec3& x) {
+  return {dot(rows[0], x), dot(rows[1], x), dot(rows[2], x)};
+}
 inline bool is_finite(const Vec3& a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
 
 }  // namespace arlequin

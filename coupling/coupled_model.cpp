@@ -27,25 +27,27 @@ bool weight_models(dem::DemModel& dem, continuum::ContinuumSolver& continuum, co
   dem.apply_arlequin_weight([&zone](const Vec3& x) { return zone.alpha_d(x); }, zone.mass_floor());
   dem.particles.position.swap(current);
   continuum.set_weight([zone](const Vec3& x) { return zone.alpha_c(x); });
-  // A node mass below 1e-12 of the largest is a zero that round-off kept positive.
-  const auto& m = continuum.lumped_mass();
-  const double tiny = 1e-12 * *std::max_element(m.begin(), m.end());
-  if (std::all_of(m.begin(), m.end(), [tiny](double v) { return v > tiny; })) return false;
+  // The first node without mass, or -1; a node mass below 1e-12 of the largest is a zero that
+  // round-off kept positive.
+  const auto first_massless_node = [&continuum] {
+    const auto& m = continuum.lumped_mass();
+    const double tiny = 1e-12 * *std::max_element(m.begin(), m.end());
+    const auto it = std::find_if(m.begin(), m.end(), [tiny](double v) { return !(v > tiny); });
+    return it == m.end() ? -1 : int(it - m.begin());
+  };
+  if (first_massless_node() < 0) return false;
   // A node with alpha_c = 0 at all its mass points (e.g. a natural-neighbour node on the
   // DEM-side edge of the overlap): ContinuumSolver weights mass and stiffness alike, so the only
   // floor available is on both (a stiffness of eps times the material there).
   const double eps = zone.mass_floor();
   continuum.set_weight([zone, eps](const Vec3& x) { return std::max(zone.alpha_c(x), eps); });
-  const auto& floored = continuum.lumped_mass();
-  const double floored_tiny = 1e-12 * *std::max_element(floored.begin(), floored.end());
-  for (int n = 0; n < continuum.num_nodes(); ++n)
-    if (!(floored[n] > floored_tiny)) {
-      const Vec3& x = continuum.nodes()[n];
-      std::ostringstream msg;
-      msg << "coupling: continuum node " << n << " at (" << x.x << ", " << x.y << ", " << x.z
-          << ") has no mass even with the floor";
-      throw InputError(msg.str());
-    }
+  if (const int n = first_massless_node(); n >= 0) {
+    const Vec3& x = continuum.nodes()[n];
+    std::ostringstream msg;
+    msg << "coupling: continuum node " << n << " at (" << x.x << ", " << x.y << ", " << x.z
+        << ") has no mass even with the floor";
+    throw InputError(msg.str());
+  }
   return true;
 }
 

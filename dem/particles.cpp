@@ -26,43 +26,15 @@ void ParticleSet::clear_forces() {
 }
 
 void ParticleSet::move_entry(std::size_t from, std::size_t to) {
-  if (from == to) return;
-  position[to] = position[from];
-  reference[to] = reference[from];
-  velocity[to] = velocity[from];
-  orientation[to] = orientation[from];
-  angular_velocity[to] = angular_velocity[from];
-  force[to] = force[from];
-  torque[to] = torque[from];
-  radius[to] = radius[from];
-  inv_mass[to] = inv_mass[from];
-  groups[to] = groups[from];
+  if (from != to) for_each_array([&](auto& array) { array[to] = array[from]; });
 }
 
 void ParticleSet::resize(std::size_t n) {
-  position.resize(n);
-  reference.resize(n);
-  velocity.resize(n);
-  orientation.resize(n);
-  angular_velocity.resize(n);
-  force.resize(n);
-  torque.resize(n);
-  radius.resize(n);
-  inv_mass.resize(n);
-  groups.resize(n);
+  for_each_array([n](auto& array) { array.resize(n); });
 }
 
 void ParticleSet::reserve(std::size_t n) {
-  position.reserve(n);
-  reference.reserve(n);
-  velocity.reserve(n);
-  orientation.reserve(n);
-  angular_velocity.reserve(n);
-  force.reserve(n);
-  torque.reserve(n);
-  radius.reserve(n);
-  inv_mass.reserve(n);
-  groups.reserve(n);
+  for_each_array([n](auto& array) { array.reserve(n); });
 }
 
 }  // namespace arlequin::dem

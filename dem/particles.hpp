@@ -48,6 +48,12 @@ struct ParticleSet {
   std::size_t keep_only(Keep keep);
 
  private:
+  // Applies f to every per-DE array: one list of the arrays for reserve, resize and moves.
+  template <class F>
+  void for_each_array(F f) {
+    f(position), f(reference), f(velocity), f(orientation), f(angular_velocity);
+    f(force), f(torque), f(radius), f(inv_mass), f(groups);
+  }
   void move_entry(std::size_t from, std::size_t to);
   void resize(std::size_t n);
 };
