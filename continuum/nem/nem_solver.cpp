@@ -304,41 +304,50 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   node_density_.resize(n);
   for (int i = 0; i < n; ++i) node_density_[i] = materials_[node_material[i]].density;
 
-  // Integration (see the header): per node its clipped Voronoi cell, the flux int phi_J n dS
-  // through every face, then one integration point per sub-cell (pyramid from the cell centroid
-  // to a face) with gradients b_J = (face flux + flux through the pyramid's sides) / volume.
+  // Integration (see the header): per node i its clipped Voronoi cell V_i, cut into one
+  // sub-cell per cell vertex v: the union of the tetrahedra (x_i, face centre, edge midpoint, v).
+  // One integration point per sub-cell, b_J = (int phi_J n dS over its surface) / volume.
   using Flux = std::vector<std::pair<int, Vec3>>;  // (J, int phi_J n dS)
   std::vector<Dt3::Vertex_handle> vh(n);
   for (auto v = g.dt.finite_vertices_begin(); v != g.dt.finite_vertices_end(); ++v) vh[v->info()] = v;
   Coords phi;
-  // Midpoint rule on a triangle with midpoint q and area vector an (area times unit normal);
-  // plane >= 0: q lies on that domain plane. Leaves the coordinates of q in phi.
-  auto add_flux = [&](const Vec3& q, const Vec3& an, int plane, Flux& out) {
+  auto centre = [](const std::vector<Vec3>& pts) {
+    Vec3 c{};
+    for (const Vec3& p : pts) c += p;
+    return c / static_cast<double>(pts.size());
+  };
+  // Midpoint rule on triangle (a, b, c) with area vector an (area times unit normal); plane >= 0:
+  // the triangle lies on that domain plane, its point then also joins the boundary rule for
+  // tractions (so loads and gradients satisfy the same integration constraint).
+  std::vector<Eigen::Triplet<double>> boundary_phi;
+  auto add_flux = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& an, int plane, Flux& out) {
+    const double area = norm(an);
+    if (!(area > 0)) return;
+    const Vec3 q = (a + b + c) / 3.0;
     if (!(plane >= 0 ? g.on_plane(plane, q, phi) : g.coords(q, phi)))
       throw RunError("nem: natural-neighbour coordinates failed at a Voronoi cell point");
     for (const auto& [J, value] : phi) out.push_back({J, value * an});
-  };
-  auto centre = [](const Face& f) {
-    Vec3 c{};
-    for (const Vec3& p : f.pts) c += p;
-    return c / static_cast<double>(f.pts.size());
-  };
-  // Volume and first moment of the pyramid from apex to face f, by the tetrahedra (apex, c, a, b)
-  // of the face's fan (c its vertex centre).
-  auto pyramid = [&](const Face& f, const Vec3& apex, double& volume, Vec3& moment) {
-    const Vec3 c = centre(f);
-    volume = 0;
-    moment = {};
-    for (size_t k = 0; k < f.pts.size(); ++k) {
-      const Vec3 &a = f.pts[k], &b = f.pts[(k + 1) % f.pts.size()];
-      const double v = 0.5 * norm(cross(a - c, b - c)) * dot(c - apex, f.n) / 3.0;
-      volume += v;
-      moment += (0.25 * v) * (apex + c + a + b);
+    if (plane >= 0) {
+      for (const auto& [J, value] : phi) boundary_phi.emplace_back(static_cast<int>(boundary_.x.size()), J, value);
+      boundary_.x.push_back(q);
+      boundary_.w.push_back(area);
     }
   };
-  // Face between cells i < j: polygon and flux from cell i, kept until cell j takes them.
-  std::map<std::pair<int, int>, std::pair<std::vector<Vec3>, Flux>> shared;
-  std::vector<Eigen::Triplet<double>> boundary_phi;
+  // Face between cells i < j: its polygon and the flux through the part of it around each of its
+  // vertices, from cell i, kept until cell j takes them reversed. Clipping the two cells gives
+  // polygons equal only to the clipping tolerance; sharing one keeps every sub-cell closed (grad x
+  // = I to round-off) and makes the fluxes cancel exactly between the cells. A face too small to
+  // survive clipping on one side is integrated on the other alone.
+  struct FaceParts {
+    std::vector<Vec3> pts;
+    std::vector<Flux> flux;  // per polygon vertex
+  };
+  std::map<std::pair<int, int>, FaceParts> shared;
+  struct SubCell {
+    double volume = 0;
+    Vec3 moment{};
+    Flux flux;
+  };
   cell_volume_.assign(n, 0.0);
   for (int i = 0; i < n; ++i) {
     Polyhedron cell = domain;
@@ -349,75 +358,82 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       const Vec3 nn = normalized(X[j] - X[i]);
       clip(cell, nn, dot(nn, 0.5 * (X[i] + X[j])), j, 1e-12 * L);
     }
-    // Face fluxes. A face shared with an earlier cell comes from it, flux reversed, and so does
-    // its polygon (clipping the two cells gives polygons equal only to the clipping tolerance,
-    // and each sub-cell must be closed for its gradients to be exact on linear fields). A face
-    // too small to survive clipping on one side is integrated on the other alone.
-    std::vector<Flux> face_flux(cell.size());
-    for (size_t k = 0; k < cell.size(); ++k) {
-      Face& f = cell[k];
-      Flux& flux = face_flux[k];
+    // The cell's vertices, each polygon corner mapped to one (corners within the tolerance are
+    // one vertex).
+    std::vector<Vec3> vertex;
+    auto vertex_id = [&](const Vec3& p) {
+      for (size_t k = 0; k < vertex.size(); ++k)
+        if (norm(vertex[k] - p) <= g.tol) return static_cast<int>(k);
+      vertex.push_back(p);
+      return static_cast<int>(vertex.size()) - 1;
+    };
+    std::vector<SubCell> sub;
+    for (Face& f : cell) {
+      // The part around corner m: triangles (c, mid(m-1, m), p_m) and (c, p_m, mid(m, m+1)).
+      FaceParts parts;
       const auto from = f.tag >= 0 && f.tag < i ? shared.find({f.tag, i}) : shared.end();
       if (from != shared.end()) {
-        f.pts = std::move(from->second.first);
-        for (const auto& [J, v] : from->second.second) flux.push_back({J, -v});
+        parts = std::move(from->second);
+        for (Flux& flux : parts.flux)
+          for (auto& [J, v] : flux) v = -v;
         shared.erase(from);
-        continue;
-      }
-      const Vec3 c = centre(f);
-      for (size_t e = 0; e < f.pts.size(); ++e) {
-        const Vec3 &a = f.pts[e], &b = f.pts[(e + 1) % f.pts.size()];
-        const double area = 0.5 * norm(cross(a - c, b - c));
-        if (area <= 0) continue;
-        const Vec3 q = (a + b + c) / 3.0;
-        add_flux(q, area * f.n, f.tag >= 0 ? -1 : -1 - f.tag, flux);
-        if (f.tag < 0) {
-          for (const auto& [J, value] : phi) boundary_phi.emplace_back(static_cast<int>(boundary_.x.size()), J, value);
-          boundary_.x.push_back(q);
-          boundary_.w.push_back(area);
+        f.pts = parts.pts;
+      } else {
+        parts.pts = f.pts;
+        parts.flux.resize(f.pts.size());
+        const Vec3 c = centre(f.pts);
+        const int plane = f.tag >= 0 ? -1 : -1 - f.tag;
+        const size_t k = f.pts.size();
+        for (size_t m = 0; m < k; ++m) {
+          const Vec3 &p = f.pts[m], before = 0.5 * (f.pts[(m + k - 1) % k] + p), after = 0.5 * (p + f.pts[(m + 1) % k]);
+          add_flux(c, before, p, 0.5 * norm(cross(before - c, p - c)) * f.n, plane, parts.flux[m]);
+          add_flux(c, p, after, 0.5 * norm(cross(p - c, after - c)) * f.n, plane, parts.flux[m]);
         }
+        if (f.tag > i) shared[{i, f.tag}] = parts;
       }
-      if (f.tag > i) shared[{i, f.tag}] = {f.pts, flux};
+      const Vec3 c = centre(f.pts);
+      const double height = dot(c - X[i], f.n);  // of x_i over the face plane (>= 0)
+      const size_t k = f.pts.size();
+      // The polygon's turning sense about the outward normal: +1 counter-clockwise.
+      Vec3 turning{};
+      for (size_t m = 0; m < k; ++m) turning += cross(f.pts[m] - c, f.pts[(m + 1) % k] - c);
+      const double sense = dot(turning, f.n) >= 0 ? 1.0 : -1.0;
+      std::vector<int> id(k);
+      for (size_t m = 0; m < k; ++m) id[m] = vertex_id(f.pts[m]);
+      if (sub.size() < vertex.size()) sub.resize(vertex.size());
+      for (size_t m = 0; m < k; ++m) {
+        const Vec3 &p = f.pts[m], before = 0.5 * (f.pts[(m + k - 1) % k] + p), after = 0.5 * (p + f.pts[(m + 1) % k]);
+        SubCell& s_m = sub[id[m]];
+        s_m.flux.insert(s_m.flux.end(), parts.flux[m].begin(), parts.flux[m].end());
+        for (const auto& [a, b] : {std::pair{before, p}, std::pair{p, after}}) {
+          const double v = 0.5 * norm(cross(a - c, b - c)) * height / 3.0;
+          s_m.volume += v;
+          s_m.moment += (0.25 * v) * (X[i] + c + a + b);
+        }
+        // Triangle (x_i, c, mid(m, m+1)) between the sub-cells of corners m and m + 1.
+        const int next = id[(m + 1) % k];
+        if (next == id[m]) continue;
+        // Out of corner m's part, as a side of the tetrahedron (x_i, c, p_m, after) whose base
+        // is outward: signed, so it holds when x_i lies on the face (flat tetrahedra) too.
+        const Vec3 an = 0.5 * sense * cross(c - X[i], after - X[i]);
+        Flux flux;
+        add_flux(X[i], c, after, an, -1, flux);
+        s_m.flux.insert(s_m.flux.end(), flux.begin(), flux.end());
+        for (auto& [J, value] : flux) sub[next].flux.push_back({J, -value});
+      }
     }
-    // Cell volume and centroid (pyramids from the node, which lies in its closed cell).
     double volume = 0;
-    Vec3 centroid{};
-    for (const Face& f : cell) {
-      double v;
-      Vec3 m;
-      pyramid(f, X[i], v, m);
-      volume += v;
-      centroid += m;
-    }
+    for (const SubCell& sk : sub) volume += sk.volume;
     if (!(volume > 0)) throw RunError("nem: empty Voronoi cell at node " + std::to_string(i));
-    centroid = centroid / volume;
     cell_volume_[i] = volume;
-    // Sub-cells. A thin pyramid (|V_K| < 1e-3 |V_i|: small faces, many left by nearly
-    // cospherical nodes) has a surface-to-volume ratio that amplifies round-off in its gradients
-    // (seen: 2e-11 in grad x at |V_K| ~ 1e-6 |V_i|), so it is merged into the cell's largest
-    // sub-cell; a union of pyramids is still a closed smoothing domain.
-    struct SubCell {
-      double volume;
-      Vec3 moment;
-      Flux flux;
-    };
-    std::vector<SubCell> sub(cell.size());
+    // A thin sub-cell (|V_K| < 1e-3 |V_i|: a short cell edge, many left by nearly cospherical
+    // nodes; or a corner where the node itself sits) has a surface-to-volume ratio that amplifies
+    // round-off in its gradients (seen: 2e-11 in grad x at |V_K| ~ 1e-6 |V_i|), so it is merged
+    // into the cell's largest sub-cell; a union of closed smoothing domains is one.
     size_t largest = 0;
-    for (size_t k = 0; k < cell.size(); ++k) {
-      const Face& f = cell[k];
-      SubCell& sk = sub[k];
-      pyramid(f, centroid, sk.volume, sk.moment);
-      sk.flux = std::move(face_flux[k]);
-      const Vec3 c = centre(f);
-      for (size_t e = 0; e < f.pts.size(); ++e) {
-        const Vec3 &a = f.pts[e], &b = f.pts[(e + 1) % f.pts.size()];
-        Vec3 an = 0.5 * cross(a - centroid, b - centroid);  // side (centroid, a, b), outward:
-        if (dot(an, c - centroid) > 0) an = -an;            // away from the face's centre
-        if (norm(an) > 0) add_flux((centroid + a + b) / 3.0, an, -1, sk.flux);
-      }
-      if (sk.volume > sub[largest].volume) largest = k;
-    }
-    const auto merged = [&](size_t k) { return k != largest && sub[k].volume < 1e-3 * volume; };
+    for (size_t k = 0; k < sub.size(); ++k)
+      if (sub[k].volume > sub[largest].volume) largest = k;
+    const auto merged = [&](size_t k) { return k != largest && sub[k].volume < 1e-2 * volume; };
     for (size_t k = 0; k < sub.size(); ++k) {
       if (!merged(k)) continue;
       SubCell& into = sub[largest];

@@ -6,9 +6,9 @@
 //   flat boundary face the 2D coordinates of the face's own nodes are used (the limit of the
 //   3D ones on a convex hull), and on an edge of the domain the 1D linear interpolant.
 // - Integration: stabilised conforming nodal integration (SCNI; Chen, Wu, Yoon & You, IJNME 50
-//   (2001)) with the sub-cell modification of Puso, Chen, Zywicz & Elmer, IJNME 74 (2008)
-//   ("MSCNI"). Per node L its Voronoi cell V_L clipped to the domain, cut into sub-cells V_LK:
-//   the pyramids from the cell centroid to each face. On any region W the smoothed gradient is
+//   (2001)) with sub-cells in the spirit of Puso, Chen, Zywicz & Elmer, IJNME 74 (2008)
+//   ("MSCNI"). Per node L its Voronoi cell V_L clipped to the domain, cut into sub-cells V_LK.
+//   On any region W the smoothed gradient is
 //       b_J(W) = (1/|W|) int_{dW} phi_J n dS                                      (SCNI)
 //   and MSCNI's strain energy is
 //       E = 1/2 sum_L [ |V_L| e_L.C e_L + a sum_K |V_LK| (e_LK - e_L).C (e_LK - e_L) ],
@@ -17,13 +17,27 @@
 //   each sub-cell is an integration point, which is how it is done here. Plain SCNI (a = 0)
 //   has spurious low-energy modes in 3D: on the unit cube, the lowest Dirichlet eigenvalues of
 //   M^-1 K were oscillating modes at 1/7 of the lowest FE one, with an error that did not
-//   decrease under refinement (L2 rate 0.9); with a = 1 they are the smooth ones and the rate
-//   is 1.9 (tests/continuum/test_nem.cpp). The apex is the cell centroid rather than the node
-//   as in Puso et al., because a boundary node lies on faces of its own cell (flat pyramids);
-//   pyramids thinner than 1e-3 |V_L| are merged into the cell's largest one (round-off).
-//   Surface integrals use the midpoint rule on a fan triangulation of every face (exact for
-//   linear fields, so grad of x = I to round-off and the patch test is passed); cell faces
-//   shared by two nodes are integrated once, for both.
+//   decrease under refinement (L2 rate 0.9).
+//   Our sub-cells: one per vertex v of the cell, the union of the tetrahedra (x_L, centre of a
+//   face at v, midpoint of an edge of that face at v, v); its surface is the part of each face
+//   around v and the triangles (x_L, face centre, edge midpoint) it shares with the sub-cells of
+//   the neighbouring vertices. Puso et al. use the pyramids from the node to each face; on a
+//   regular grid the pyramid on a face parallel to the x axis spans the whole cell along x, so
+//   its e_xx is the central difference (u_{I+1} - u_{I-1}) / 2h, blind to the mode alternating
+//   from node to node: two thirds of a cubic cell's volume then carried no stiffness for that
+//   mode, the cut-off frequency dropped to ~0.6 of P1's and a pulse crossing into a coarse
+//   cloud rang (cases/wave_bar_coupled: 6.2 % reflected at 1.6 lambda_c against P1's 0.4 %).
+//   A vertex sub-cell lies on one side of the node along each axis of a regular grid, so its
+//   strain is a one-sided difference: the alternating mode keeps 0.63 of its P1 energy (0.35
+//   with pyramids; not 1, as the interpolant on a node's plane also draws on the planes beside
+//   it) and the reflection there drops to 2.1 %. L2 rate 2.0 on the unit cube.
+//   Sub-cells under 1e-2 |V_L| (short cell edges, left by nearly cospherical nodes; the corner
+//   of a cell where its node sits) are merged into the cell's largest one: their surface-to-
+//   volume ratio amplifies round-off in the gradients; a union of closed smoothing domains is one.
+//   Surface integrals use the midpoint rule on triangles (two per face corner, from the face
+//   centre; exact for linear fields, so grad of x = I to round-off and the patch test is
+//   passed); cell faces shared by two nodes, and triangles shared by two sub-cells, are
+//   integrated once, for both, so their fluxes cancel exactly (the integration constraint).
 // - Tractions use the same rule on the cell faces lying on the boundary (each point belongs to
 //   the mesh boundary triangle that holds it), so loads and smoothed gradients satisfy the same
 //   integration constraint and the traction (Neumann) patch test is passed exactly.

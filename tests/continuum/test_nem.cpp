@@ -45,15 +45,17 @@ TEST(ContinuumNem, ConsistencyOfShapeFunctionsAndCells) {
       EXPECT_NEAR(sum, 1.0, 1e-12) << shape << " point " << p;
       EXPECT_LT(norm(x - pts[p]), 1e-12) << shape << " point " << p;
     }
-    // Smoothed gradient of u = x is the identity at every node: load u = x and read the strain
+    constexpr double kStrainRoundOff = 1e-11;
+    // Smoothed gradient of u = x is the identity at every integration point (to the round-off of
+    // some hundred flux terms over a sub-cell a fiftieth of its cell): load u = x and read the strain
     // (eps_xx = eps_yy = eps_zz = 1, shears 0) ...
     for (int n = 0; n < s->num_nodes(); ++n)
       for (int c = 0; c < 3; ++c) s->displacement()[3 * n + c] = s->nodes()[n][c];
     for (const Voigt& e : s->point_strain()) {
-      EXPECT_NEAR(e[0], 1.0, 1e-12);
-      EXPECT_NEAR(e[1], 1.0, 1e-12);
-      EXPECT_NEAR(e[2], 1.0, 1e-12);
-      EXPECT_NEAR(e.tail<3>().norm(), 0.0, 1e-12);
+      EXPECT_NEAR(e[0], 1.0, kStrainRoundOff);
+      EXPECT_NEAR(e[1], 1.0, kStrainRoundOff);
+      EXPECT_NEAR(e[2], 1.0, kStrainRoundOff);
+      EXPECT_NEAR(e.tail<3>().norm(), 0.0, kStrainRoundOff);
     }
     // ... and with u = (y, z, x) the off-diagonal parts (eps_xy = du_x/dy + du_y/dx = 1, ...).
     for (int n = 0; n < s->num_nodes(); ++n) {
@@ -61,10 +63,10 @@ TEST(ContinuumNem, ConsistencyOfShapeFunctionsAndCells) {
       s->displacement()[3 * n] = x.y, s->displacement()[3 * n + 1] = x.z, s->displacement()[3 * n + 2] = x.x;
     }
     for (const Voigt& e : s->point_strain()) {
-      EXPECT_NEAR(e.head<3>().norm(), 0.0, 1e-12);
-      EXPECT_NEAR(e[3], 1.0, 1e-12);
-      EXPECT_NEAR(e[4], 1.0, 1e-12);
-      EXPECT_NEAR(e[5], 1.0, 1e-12);
+      EXPECT_NEAR(e.head<3>().norm(), 0.0, kStrainRoundOff);
+      EXPECT_NEAR(e[3], 1.0, kStrainRoundOff);
+      EXPECT_NEAR(e[4], 1.0, kStrainRoundOff);
+      EXPECT_NEAR(e[5], 1.0, kStrainRoundOff);
     }
     double v = 0;
     for (double vi : s->cell_volumes()) v += vi;
@@ -116,4 +118,32 @@ TEST(ValidationNem, CantileverTipDeflection) {
   const double ratio = cantilever_tip_ratio("nem", 1, 1.0 / 10);
   std::cout << "NEM cantilever tip / Timoshenko " << ratio << "\n";
   EXPECT_NEAR(ratio, 1.0, 0.02);
+}
+
+// The mode alternating from node plane to node plane, u_x = +-1, on a structured bar (node
+// planes every h): P1 carries it with the strain 2/h in every element, energy 2 E |Omega| / h^2
+// (nu = 0: no lateral terms). A smoothing domain spanning a cell along x sees the central
+// difference (u_{I+1} - u_{I-1}) / 2h = 0 there. With Puso's pyramid sub-cells two thirds of each
+// cell did (energy 0.348 of P1's), the pulse of cases/wave_bar_coupled rang and 6.2 % of it came
+// back. The vertex sub-cells (nem_solver.hpp) lie on one side of their node: 0.629. Not 1, as
+// the natural-neighbour interpolant on the node's own plane also draws on the planes beside it
+// (a point there has natural neighbours on both), so the one-sided difference is smaller than
+// P1's.
+TEST(ContinuumNem, AlternatingModeCarriesTheP1Energy) {
+  const double h = 4e-3, E = 1.0;  // meshes/coupled_bar_h2.geo: node planes from x = 4e-3 every h
+  const double volume = (236e-3 - 4e-3) * 8e-3 * 8e-3;
+  for (const std::string method : {"fe", "nem"}) {
+    auto s = make_continuum_solver(method, settings("coupled_bar_h2.geo", 0.0, 1, Material::isotropic(E, 0.0, 1.0)));
+    for (int n = 0; n < s->num_nodes(); ++n) {
+      const long plane = std::lround((s->nodes()[n].x - 4e-3) / h);
+      s->displacement()[3 * n] = plane % 2 ? -1.0 : 1.0;
+    }
+    s->compute_forces();
+    const double ratio = s->strain_energy() / (2.0 * E * volume / (h * h));
+    std::cout << method << ": alternating-mode energy / P1 closed form " << ratio << "\n";
+    if (method == "fe")
+      EXPECT_NEAR(ratio, 1.0, 1e-12);
+    else
+      EXPECT_GT(ratio, 0.6);
+  }
 }
