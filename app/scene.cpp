@@ -337,10 +337,17 @@ void read_initial(CaseNode root, dem::DemModel& model) {
   }
 }
 
-// A raised-cosine velocity pulse travelling along d at speed c: with s = (x - center).d,
-//   v(s) = A (1 + cos(2 pi s / lambda)) / 2 for |s| < lambda / 2, else 0, along d,
-//   u(s) = (1/c) int_s^inf v: zero ahead of the pulse, A lambda / (2c) behind it,
-// so that v = -c du/ds (a wave moving towards +d). Displacements are applied after bonding.
+// A velocity pulse travelling along d at speed c, s = (x - center).d, of one of two shapes:
+//   raised cosine (default): v(s) = A (1 + cos(k s)) / 2 for |s| < lambda / 2;
+//   tone burst (`cycles: N`): v(s) = A sin(k s) (1 + cos(k s / N)) / 2 for |s| < N lambda / 2,
+//     N cycles of wavelength lambda under a Hann window: a narrow band about k (half-width
+//     k / N at half height), to probe one frequency (e.g. above a continuum's cut-off);
+// k = 2 pi / lambda, v = 0 outside. Both are sums of A_m cos(m s + phase) terms; the displacement
+//   u(s) = (1/c) int_s^{L/2} v (zero ahead of the pulse)
+// is their closed-form integral, so that v = -c du/ds (a wave moving towards +d). c is the phase
+// speed: on a lattice, a short wavelength travels slower than the long-wave speed (set `speed`
+// to the lattice's c sin(k a / 2) / (k a / 2) or a little of the pulse goes backwards).
+// Displacements are applied after bonding.
 void read_pulse(CaseNode root, dem::DemModel& model) {
   auto pulse = root.child_if("pulse");
   if (!pulse) return;
@@ -352,14 +359,35 @@ void read_pulse(CaseNode root, dem::DemModel& model) {
   const double lambda = pulse->number("wavelength", Range::positive(), "m");
   const double A = pulse->number("amplitude", Range::any(), "m/s");
   const double c = pulse->number("speed", Range::positive(), "m/s");
+  const long long cycles = pulse->has("cycles") ? pulse->integer("cycles", Range::at_least(1)) : 0;
   pulse->finish();
   const double k = 2.0 * std::numbers::pi / lambda;
+  // v(s) = sum of a cos(m s) + b sin(m s) over (a, b, m), for |s| < L / 2.
+  struct Term {
+    double a, b, m;
+  };
+  std::vector<Term> terms;
+  double L = lambda;
+  if (cycles > 0) {
+    L = static_cast<double>(cycles) * lambda;
+    const double K = k / static_cast<double>(cycles);  // sin(ks) (1 + cos(Ks)) / 2 = sin(ks) / 2 + [sin((k+K)s) + sin((k-K)s)] / 4
+    terms = {{0.0, 0.5 * A, k}, {0.0, 0.25 * A, k + K}, {0.0, 0.25 * A, k - K}};
+  } else {
+    terms = {{0.5 * A, 0.0, 0.0}, {0.5 * A, 0.0, k}};
+  }
+  // int of a cos(m t) + b sin(m t) from t = s to L / 2 (m = 0: a (L/2 - s)).
+  const auto integral = [&](const Term& t, double s) {
+    if (t.m == 0.0) return t.a * (0.5 * L - s);
+    return (t.a * (std::sin(0.5 * t.m * L) - std::sin(t.m * s)) - t.b * (std::cos(0.5 * t.m * L) - std::cos(t.m * s))) / t.m;
+  };
   for (std::uint32_t i : model.members(g)) {
     const double s = dot(model.particles.position[i] - center, d);
-    const double v = std::abs(s) < 0.5 * lambda ? 0.5 * A * (1.0 + std::cos(k * s)) : 0.0;
-    const double ahead = std::clamp(0.5 * lambda - s, 0.0, lambda);  // length of pulse ahead of s
-    const double sc = std::clamp(s, -0.5 * lambda, 0.5 * lambda);
-    const double u = 0.5 * A / c * (ahead - (std::sin(k * sc) - std::sin(0.5 * k * lambda)) / k);
+    const double sc = std::clamp(s, -0.5 * L, 0.5 * L);
+    double v = 0.0, u = 0.0;
+    for (const Term& t : terms) {
+      if (std::abs(s) < 0.5 * L) v += t.a * std::cos(t.m * s) + t.b * std::sin(t.m * s);
+      u += integral(t, sc) / c;
+    }
     model.particles.velocity[i] += d * v;
     model.particles.position[i] += d * u;
   }
