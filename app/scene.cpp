@@ -229,6 +229,10 @@ void read_failure(CaseNode failure, dem::DemModel& model, const std::vector<std:
     static constexpr std::string_view averages[] = {"none", "bonded_neighbours"};
     settings.average = rdef->choice_or("average", "none", averages) == "bonded_neighbours" ? dem::RdefAverage::bonded_neighbours
                                                                                             : dem::RdefAverage::none;
+    static constexpr std::string_view volumes[] = {"sphere", "laguerre"};
+    settings.volume = rdef->choice_or("volume", "sphere", volumes) == "laguerre" ? dem::RdefVolume::laguerre : dem::RdefVolume::sphere;
+    if (settings.volume == dem::RdefVolume::laguerre && rdef->has("compaction"))
+      rdef->fail("compaction", "only for volume: sphere (a Laguerre cell needs no compaction)");
     settings.compaction = rdef->number_or("compaction", 0.63, Range::open_between(0.0, 1.0), "1");
     rdef->finish();
     model.enable_rdef(settings);

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "common/error.hpp"
+#include "dem/laguerre_cells.hpp"
 
 namespace arlequin::dem {
 
@@ -112,6 +113,12 @@ void DemModel::finalize() {
           rdef_class_[i] = static_cast<int>(g);
           break;
         }
+    rdef_omega_ = rdef_->volume == RdefVolume::laguerre ? laguerre_volumes(particles.reference, particles.radius)
+                                                         : sphere_volume_shares(rdef_->compaction);
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      if (!(rdef_omega_[i] > 0.0))
+        throw InputError("RDEF: DE " + std::to_string(i) + " has an empty Laguerre cell (its centre lies in its neighbours' " +
+                         "cells: spheres overlapping by more than their radii); use volume: sphere");
   }
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
@@ -254,7 +261,7 @@ void DemModel::apply_failures() {
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) {
     const ParticleSet& p = particles;
-    virial_stress(rdef_->compaction, rdef_stress_);
+    virial_stress(rdef_omega_, rdef_stress_);
     if (rdef_->average == RdefAverage::bonded_neighbours) average_over_bonded_neighbours(rdef_stress_);
     rdef_equivalent_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -289,47 +296,51 @@ void DemModel::apply_failures() {
 }
 
 void DemModel::average_over_bonded_neighbours(std::vector<Sym3>& sigma) {
-  // Omega_k is proportional to R_k^3 (the compaction cancels): sum R^3 sigma / sum R^3, over
-  // the partners with the DE's own threshold (its material): across a fibre-matrix interface
-  // the stresses differ by the stiffness ratio, and mixing them would fail the matrix at once.
+  // sum Omega sigma / sum Omega over the DE and its partners with the DE's own threshold (its
+  // material): across a fibre-matrix interface the stresses differ by the stiffness ratio, and
+  // mixing them would fail the matrix at once.
   const ParticleSet& p = particles;
   rdef_average_.resize(p.size());
   rdef_volume_.resize(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
-    rdef_volume_[i] = std::pow(p.radius[i], 3);
-    for (int c = 0; c < 6; ++c) rdef_average_[i][c] = rdef_volume_[i] * sigma[i][c];
+    rdef_volume_[i] = rdef_omega_[i];
+    for (int c = 0; c < 6; ++c) rdef_average_[i][c] = rdef_omega_[i] * sigma[i][c];
   }
   for (const auto& set : bond_sets_)
     for (std::size_t b = 0; b < set->size(); ++b) {
       if (set->broken()[b]) continue;
       const std::uint32_t i = set->first()[b], j = set->second()[b];
       if (rdef_class_[i] != rdef_class_[j]) continue;
-      const double vi = std::pow(p.radius[i], 3), vj = std::pow(p.radius[j], 3);
       for (int c = 0; c < 6; ++c) {
-        rdef_average_[i][c] += vj * sigma[j][c];
-        rdef_average_[j][c] += vi * sigma[i][c];
+        rdef_average_[i][c] += rdef_omega_[j] * sigma[j][c];
+        rdef_average_[j][c] += rdef_omega_[i] * sigma[i][c];
       }
-      rdef_volume_[i] += vj;
-      rdef_volume_[j] += vi;
+      rdef_volume_[i] += rdef_omega_[j];
+      rdef_volume_[j] += rdef_omega_[i];
     }
   for (std::size_t i = 0; i < p.size(); ++i)
     for (int c = 0; c < 6; ++c) sigma[i][c] = rdef_average_[i][c] / rdef_volume_[i];
 }
 
+std::vector<double> DemModel::sphere_volume_shares(double compaction) const {
+  std::vector<double> omega(particles.size());
+  for (std::size_t i = 0; i < omega.size(); ++i)
+    omega[i] = 4.0 / 3.0 * std::numbers::pi * std::pow(particles.radius[i], 3) / compaction;
+  return omega;
+}
+
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {
   std::vector<Sym3> sigma;
-  virial_stress(compaction, sigma);
+  virial_stress(sphere_volume_shares(compaction), sigma);
   return sigma;
 }
 
-void DemModel::virial_stress(double compaction, std::vector<Sym3>& sigma) const {
+void DemModel::virial_stress(const std::vector<double>& omega, std::vector<Sym3>& sigma) const {
+  // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij) (failure.hpp, seed Eq. 1).
   sigma.assign(particles.size(), Sym3{});
   for (const auto& set : bond_sets_) set->accumulate_virial(particles, sigma);
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij), Omega_i = (4/3 pi R^3) / compaction.
-    const double omega = 4.0 / 3.0 * std::numbers::pi * std::pow(particles.radius[i], 3) / compaction;
-    for (double& c : sigma[i]) c /= 2.0 * omega;
-  }
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    for (double& c : sigma[i]) c /= 2.0 * omega[i];
 }
 
 std::vector<double> DemModel::damage() const {

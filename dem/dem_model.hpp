@@ -64,7 +64,8 @@ class DemModel {
   void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
 
   // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
-  // stress reaches the DE's threshold; Omega_i = sphere volume / compaction. A DE in one of
+  // stress reaches the DE's threshold; Omega_i = sphere volume / compaction, or the DE's
+  // Laguerre cell (`volume`, computed once at finalize in the reference configuration). A DE in one of
   // the listed groups takes that group's threshold (the first listed that holds it), any
   // other DE `threshold` (infinite: such DEs never fail by RDEF). With `average` =
   // bonded_neighbours the stress judged is the volume average over the DE and the DEs of its
@@ -76,6 +77,7 @@ class DemModel {
     double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
     std::vector<std::pair<int, double>> group_thresholds;  // (group index, Pa), e.g. per material
     RdefAverage average = RdefAverage::none;
+    RdefVolume volume = RdefVolume::sphere;
   };
   void enable_rdef(const RdefSettings& settings) { rdef_ = settings; }
 
@@ -101,7 +103,6 @@ class DemModel {
   // Virial stress of every DE over its intact bonds (failure.hpp, seed Eq. 1), Pa, with the
   // volume share Omega_i = sphere volume / compaction.
   std::vector<Sym3> virial_stress(double compaction) const;
-  void virial_stress(double compaction, std::vector<Sym3>& sigma) const;  // into sigma (resized)
   // Fraction of each DE's bonds that are broken (0 for a DE without bonds).
   std::vector<double> damage() const;
 
@@ -130,6 +131,9 @@ class DemModel {
   void record_reactions();
   void apply_failures();
   void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
+  // Virial stress of every DE with the volume shares omega (m^3), into sigma (resized).
+  void virial_stress(const std::vector<double>& omega, std::vector<Sym3>& sigma) const;
+  std::vector<double> sphere_volume_shares(double compaction) const;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;
   void apply_loads_and_damping();
@@ -156,7 +160,8 @@ class DemModel {
   std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial stress per DE
   std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
   std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega
-  std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (in R^3 units)
+  std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (m^3)
+  std::vector<double> rdef_omega_;       // RDEF: each DE's volume share Omega_i (m^3, finalize)
   GroupMask watched_ = 0;
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;

@@ -5,8 +5,9 @@
 // RDEF (seed paper Eq. 1): the virial stress of DE i over its intact bonds,
 //   sigma_i = 1 / (2 Omega_i) sum_j 1/2 (r_ij (x) f_ij + f_ij (x) r_ij),
 // r_ij = x_j - x_i, f_ij the force of the bond on DE i (towards j in tension, so tension is
-// positive), Omega_i the DE's volume share (sphere volume / compaction, so the shares add up to
-// the sample volume). When its equivalent stress (the largest principal stress, von Mises, or
+// positive), Omega_i the DE's volume share: sphere volume / compaction (so the shares add up to
+// the sample volume on average), or (our option, `volume: laguerre`) its Laguerre cell, which
+// adds up to it exactly and gives a small DE among large ones the room they leave it. When its equivalent stress (the largest principal stress, von Mises, or
 // the hydrostatic stress) reaches the threshold, every bond of the DE breaks; the DE stays and
 // interacts by contact.
 // Averaged RDEF (our option, not in the seed): the stress judged is
@@ -14,9 +15,10 @@
 // that share its threshold (its material), i.e. the virial of the DE's bonded neighbourhood
 // in its own material over that neighbourhood's volume. In a random packing the per-DE
 // virial of one uniform strain scatters with the DE's radius against its neighbours' (the
-// bond forces grow with the neighbours' size, Omega_i with R_i^3), so the most loaded DEs
-// fail long before the macroscopic strength; the neighbourhood average keeps the criterion's
-// meaning (a stress of the material around the DE) with less of that scatter.
+// bond forces grow with the neighbours' size, a sphere's Omega_i with R_i^3), so the most
+// loaded DEs fail long before the macroscopic strength; the neighbourhood average keeps the
+// criterion's meaning (a stress of the material around the DE) with less of that scatter, and
+// Laguerre volume shares remove the part of it that comes from R_i^3.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -48,6 +50,9 @@ double hydrostatic(const Sym3& t);  // trace / 3 (tension positive)
 enum class RdefEquivalent : std::uint8_t { max_principal, von_mises, hydrostatic };
 double equivalent_stress(const Sym3& t, RdefEquivalent kind);
 enum class RdefAverage : std::uint8_t { none, bonded_neighbours };
+// The DE's volume share Omega_i: its sphere volume / compaction, or its Laguerre cell
+// (laguerre_cells.hpp) in the sample's box.
+enum class RdefVolume : std::uint8_t { sphere, laguerre };
 
 enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef };
 enum class FailureMode : std::uint8_t { tension, compression, bending, shear, torsion };

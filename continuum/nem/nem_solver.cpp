@@ -16,6 +16,7 @@
 #include <map>
 #include <set>
 
+#include "common/convex_polyhedron.hpp"
 #include "common/error.hpp"
 
 namespace arlequin::continuum {
@@ -40,65 +41,6 @@ struct Plane {
   Dt2 dt;  // the plane's own nodes
   Kernel::Point_2 local(const Vec3& x) const { return {dot(x - origin, e1), dot(x - origin, e2)}; }
 };
-
-// Convex polygon face of a convex polyhedron: outward normal and a tag (>= 0: Delaunay
-// neighbour whose bisector carries it; < 0: domain plane -1 - tag).
-struct Face {
-  std::vector<Vec3> pts;
-  Vec3 n;
-  int tag;
-};
-using Polyhedron = std::vector<Face>;
-
-// Removes polygon vertices within tol of the previous one (cyclically): a vertex cut from two
-// faces is computed twice, and the copies would leave zero-area fan triangles.
-void drop_repeated(std::vector<Vec3>& pts, double tol) {
-  std::vector<Vec3> out;
-  for (const Vec3& p : pts)
-    if (out.empty() || norm(p - out.back()) > tol) out.push_back(p);
-  while (out.size() > 1 && norm(out.back() - out.front()) <= tol) out.pop_back();
-  pts = std::move(out);
-}
-
-// Keeps the part of `poly` with n.x <= d (Sutherland-Hodgman per face, plus the cap polygon).
-void clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol) {
-  bool cuts = false;
-  for (const Face& f : poly)
-    for (const Vec3& p : f.pts) cuts = cuts || dot(n, p) - d > tol;
-  if (!cuts) return;
-  Polyhedron out;
-  std::vector<Vec3> cap;
-  for (const Face& f : poly) {
-    Face g{{}, f.n, f.tag};
-    const size_t m = f.pts.size();
-    for (size_t k = 0; k < m; ++k) {
-      const Vec3 &a = f.pts[k], &b = f.pts[(k + 1) % m];
-      const double da = dot(n, a) - d, db = dot(n, b) - d;
-      if (da <= tol) g.pts.push_back(a);
-      if (std::abs(da) <= tol) cap.push_back(a);
-      if ((da < -tol && db > tol) || (da > tol && db < -tol)) {
-        const Vec3 x = a + (da / (da - db)) * (b - a);
-        g.pts.push_back(x);
-        cap.push_back(x);
-      }
-    }
-    drop_repeated(g.pts, tol);
-    if (g.pts.size() >= 3) out.push_back(std::move(g));
-  }
-  if (cap.size() >= 3) {
-    Vec3 c{};
-    for (const Vec3& p : cap) c += p;
-    c = c / static_cast<double>(cap.size());
-    const Vec3 e1 = normalized(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
-    const Vec3 e2 = cross(n, e1);
-    std::sort(cap.begin(), cap.end(), [&](const Vec3& a, const Vec3& b) {
-      return std::atan2(dot(a - c, e2), dot(a - c, e1)) < std::atan2(dot(b - c, e2), dot(b - c, e1));
-    });
-    drop_repeated(cap, tol);
-    if (cap.size() >= 3) out.push_back({std::move(cap), n, tag});
-  }
-  poly = std::move(out);
-}
 
 // Laplace (non-Sibsonian) coordinates in 2D: lambda_v = |Voronoi edge between p and v| / |p - v|
 // (Belikov et al. 1997; Sukumar, Moran, Semenov & Belikov, IJNME 50 (2001)). The edge joins the
@@ -284,15 +226,9 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   Polyhedron domain;
   {
     const Vec3 a = lo - 0.01 * L * Vec3{1, 1, 1}, b = hi + 0.01 * L * Vec3{1, 1, 1};
-    auto V = [&](int i, int j, int k) { return Vec3{i ? b.x : a.x, j ? b.y : a.y, k ? b.z : a.z}; };
-    domain = {{{V(0, 0, 0), V(0, 1, 0), V(0, 1, 1), V(0, 0, 1)}, {-1, 0, 0}, -1000000},
-              {{V(1, 0, 0), V(1, 0, 1), V(1, 1, 1), V(1, 1, 0)}, {1, 0, 0}, -1000000},
-              {{V(0, 0, 0), V(0, 0, 1), V(1, 0, 1), V(1, 0, 0)}, {0, -1, 0}, -1000000},
-              {{V(0, 1, 0), V(1, 1, 0), V(1, 1, 1), V(0, 1, 1)}, {0, 1, 0}, -1000000},
-              {{V(0, 0, 0), V(1, 0, 0), V(1, 1, 0), V(0, 1, 0)}, {0, 0, -1}, -1000000},
-              {{V(0, 0, 1), V(0, 1, 1), V(1, 1, 1), V(1, 0, 1)}, {0, 0, 1}, -1000000}};
+    domain = box_polyhedron(a, b, -1000000);
     for (int k = 0; k < static_cast<int>(g.planes.size()); ++k) clip(domain, g.planes[k].n, g.planes[k].d, -1 - k, 1e-12 * L);
-    for (const Face& f : domain)
+    for (const PolyFace& f : domain)
       if (f.tag == -1000000) throw InputError("nem: the mesh boundary does not close a convex domain");
   }
 
@@ -311,11 +247,6 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   std::vector<Dt3::Vertex_handle> vh(n);
   for (auto v = g.dt.finite_vertices_begin(); v != g.dt.finite_vertices_end(); ++v) vh[v->info()] = v;
   Coords phi;
-  auto centre = [](const std::vector<Vec3>& pts) {
-    Vec3 c{};
-    for (const Vec3& p : pts) c += p;
-    return c / static_cast<double>(pts.size());
-  };
   // Midpoint rule on triangle (a, b, c) with area vector an (area times unit normal); plane >= 0:
   // the triangle lies on that domain plane, its point then also joins the boundary rule for
   // tractions (so loads and gradients satisfy the same integration constraint).
@@ -368,7 +299,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       return static_cast<int>(vertex.size()) - 1;
     };
     std::vector<SubCell> sub;
-    for (Face& f : cell) {
+    for (PolyFace& f : cell) {
       // The part around corner m: triangles (c, mid(m-1, m), p_m) and (c, p_m, mid(m, m+1)).
       FaceParts parts;
       const auto from = f.tag >= 0 && f.tag < i ? shared.find({f.tag, i}) : shared.end();
@@ -381,7 +312,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       } else {
         parts.pts = f.pts;
         parts.flux.resize(f.pts.size());
-        const Vec3 c = centre(f.pts);
+        const Vec3 c = vertex_centre(f);
         const int plane = f.tag >= 0 ? -1 : -1 - f.tag;
         const size_t k = f.pts.size();
         for (size_t m = 0; m < k; ++m) {
@@ -391,7 +322,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
         }
         if (f.tag > i) shared[{i, f.tag}] = parts;
       }
-      const Vec3 c = centre(f.pts);
+      const Vec3 c = vertex_centre(f);
       const double height = dot(c - X[i], f.n);  // of x_i over the face plane (>= 0)
       const size_t k = f.pts.size();
       // The polygon's turning sense about the outward normal: +1 counter-clockwise.

@@ -183,7 +183,8 @@ TEST(Calibration, StrengthsReproduceTheTargetFailureStress) {
 }
 
 // cases/rev_failure reduced to ~2.4k DEs (mean radius 75 um, as the reduced elastic REV), BBF
-// and RDEF (per DE and averaged) with the case's calibrated strengths: the suite writes its table with the seed's
+// and RDEF (per DE, averaged, and over Laguerre cells) with the case's calibrated strengths: the
+// suite writes its table with the seed's
 // rows, each run softens after a peak stress near the rule of mixtures (1.30 GPa; looser bounds
 // than R4's, which needs >= 40k DEs), with broken fractions per bond set, breaks.csv, fields and
 // the plot of seed Figs. 5-6; the energy of the broken bonds is booked.
@@ -198,7 +199,7 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
   EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_bbf | | 1.30-1.42 | 8.86-10.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_rdef | | 1.34-1.45 | 9.80-10.90 |"), std::string::npos) << md;
   const auto rows = read_csv(dir / "out" / "failure.csv");
-  ASSERT_EQ(rows.size(), 3u);  // L_bbf, L_rdef, L_rdef_averaged
+  ASSERT_EQ(rows.size(), 4u);  // L_bbf, L_rdef, L_rdef_averaged, L_rdef_laguerre
   for (const auto& row : rows) {
     const std::string test = row.at("test");
     EXPECT_EQ(row.at("status"), "ok") << test;

@@ -107,6 +107,33 @@ TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
   EXPECT_NEAR(equivalent_stress(sigma[centre], RdefEquivalent::hydrostatic), sigma[centre][0] / 3.0, 1e-9 * applied);
 }
 
+// Laguerre volume shares (volume: laguerre): in a simple-cubic lattice every cell is the
+// lattice cube a^3 = sphere volume / (pi/6), so RDEF breaks exactly what it breaks with the
+// sphere share at compaction pi/6: just under the applied stress, the DEs with both x-bonds;
+// just over it, nothing.
+TEST(Rdef, LaguerreSharesInACubicLatticeAreTheLatticeCube) {
+  const double R = 1e-3, a = 2 * R, eps = 1e-4, E = 2e11;
+  const double applied = E * std::numbers::pi * 0.25 * R * R * eps / (a * a);
+  const auto breaks = [&](RdefVolume volume, double threshold_factor) {
+    DemModel model;
+    build_lattice(model.particles, {0, 0, 0}, {4, 3, 3}, a, R, 7800.0);
+    test::bond_all_touching(model, {E, 0.3, 0.5});
+    DemModel::RdefSettings settings{threshold_factor * applied, RdefEquivalent::max_principal, std::numbers::pi / 6.0, {}};
+    settings.volume = volume;
+    model.enable_rdef(settings);
+    model.finalize();
+    for (auto& x : model.particles.position) x.x *= 1.0 + eps;
+    model.step(1e-12);
+    return model.breaks().size();
+  };
+  // The 2 x 3 x 3 DEs with both x-bonds; their bonds: the 3 x-bonds of each of the 9 rows, and
+  // the 12 lateral bonds of each of their 2 planes of 3 x 3.
+  const std::size_t expected = 9 * 3 + 2 * 12;
+  EXPECT_EQ(breaks(RdefVolume::sphere, 0.99), expected);
+  EXPECT_EQ(breaks(RdefVolume::laguerre, 0.99), expected);
+  EXPECT_EQ(breaks(RdefVolume::laguerre, 1.01), 0u);
+}
+
 TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
   DemModel model;
   const double R = 1e-3;

@@ -1,0 +1,70 @@
+#include "dem/laguerre_cells.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "common/convex_polyhedron.hpp"
+#include "common/error.hpp"
+
+namespace arlequin::dem {
+
+std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vector<double>& r) {
+  const std::size_t n = c.size();
+  std::vector<double> volumes(n, 0.0);
+  if (n == 0) return volumes;
+  Vec3 lo = c[0], hi = c[0];
+  double r_max = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
+    r_max = std::max(r_max, r[i]);
+  }
+  const double tol = 1e-12 * norm(hi - lo);
+  // Candidates from a uniform grid of cells of size `cell`; a search reaches `reach` cells out.
+  const double cell = 2.0 * r_max;
+  int dims[3];
+  for (int k = 0; k < 3; ++k) dims[k] = std::max(1, static_cast<int>(std::ceil((hi[k] - lo[k]) / cell)));
+  auto cell_of = [&](const Vec3& x, int k) { return std::clamp(static_cast<int>((x[k] - lo[k]) / cell), 0, dims[k] - 1); };
+  std::vector<std::vector<std::size_t>> bins(static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]);
+  for (std::size_t i = 0; i < n; ++i)
+    bins[(static_cast<std::size_t>(cell_of(c[i], 2)) * dims[1] + cell_of(c[i], 1)) * dims[0] + cell_of(c[i], 0)].push_back(i);
+
+  std::vector<std::pair<double, std::size_t>> near;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int reach = 2;; reach *= 2) {
+      // Every sphere within `reach` cells, nearest first (so later planes rarely cut).
+      near.clear();
+      const int ci[3] = {cell_of(c[i], 0), cell_of(c[i], 1), cell_of(c[i], 2)};
+      for (int z = std::max(0, ci[2] - reach); z <= std::min(dims[2] - 1, ci[2] + reach); ++z)
+        for (int y = std::max(0, ci[1] - reach); y <= std::min(dims[1] - 1, ci[1] + reach); ++y)
+          for (int x = std::max(0, ci[0] - reach); x <= std::min(dims[0] - 1, ci[0] + reach); ++x)
+            for (std::size_t j : bins[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x])
+              if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+      std::sort(near.begin(), near.end());
+      Polyhedron poly = box_polyhedron(lo, hi, -1);
+      for (const auto& [d2, j] : near) {
+        if (!(d2 > 0.0)) throw InputError("laguerre cells: spheres " + std::to_string(i) + " and " + std::to_string(j) + " share a centre");
+        const Vec3 e = c[j] - c[i];
+        const double d = std::sqrt(d2);
+        // The radical plane, as (e/d).x <= offset.
+        const double offset = (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d);
+        clip(poly, e / d, offset, static_cast<int>(j), tol);
+      }
+      // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
+      // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
+      // outside the searched cells is at least `reach` cells away.
+      double extent = 0.0;
+      for (const PolyFace& f : poly)
+        for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - c[i]));
+      const double D = reach * cell;
+      const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
+      if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {
+        volumes[i] = volume(poly);
+        break;
+      }
+    }
+  }
+  return volumes;
+}
+
+}  // namespace arlequin::dem

@@ -1,0 +1,51 @@
+// Laguerre cells (dem/laguerre_cells.hpp), the RDEF volume shares, against closed forms.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "dem/laguerre_cells.hpp"
+
+using namespace arlequin;
+
+// Two touching spheres, R 1 and 0.5, centres 1.5 apart: the radical plane 2 (1.5) x = 1.5^2 -
+// 0.25 + 1 is x = 1; in the box [-1, 2] x [-1, 1]^2 the cells are 2 x 2 x 2 and 1 x 2 x 2.
+TEST(LaguerreCells, TwoSpheresSplitAtTheRadicalPlane) {
+  const auto v = dem::laguerre_volumes({{0, 0, 0}, {1.5, 0, 0}}, {1.0, 0.5});
+  EXPECT_NEAR(v[0], 8.0, 1e-12);
+  EXPECT_NEAR(v[1], 4.0, 1e-12);
+}
+
+// A simple-cubic lattice of equal touching spheres: every cell, boundary ones included (the box
+// is the spheres' bounding box), is the lattice cube (2R)^3.
+TEST(LaguerreCells, CubicLatticeGivesTheLatticeCube) {
+  const double R = 0.3;
+  std::vector<Vec3> c;
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 6; ++i) c.push_back({2 * R * i, 2 * R * j, 2 * R * k});
+  const auto v = dem::laguerre_volumes(c, std::vector<double>(c.size(), R));
+  for (double vi : v) EXPECT_NEAR(vi, 8 * R * R * R, 1e-12);
+}
+
+// Random radii and positions: the cells tile the box, and a small sphere among large ones gets
+// more than its share by R^3 (the point of using them).
+TEST(LaguerreCells, RandomSpheresTileTheirBox) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> pos(0.0, 1.0), rad(0.02, 0.08);
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  for (int i = 0; i < 400; ++i) {
+    c.push_back({pos(rng), pos(rng), pos(rng)});
+    r.push_back(rad(rng));
+  }
+  const auto v = dem::laguerre_volumes(c, r);
+  Vec3 lo = c[0], hi = c[0];
+  for (std::size_t i = 0; i < c.size(); ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
+  double sum = 0.0;
+  for (double vi : v) {
+    EXPECT_GT(vi, 0.0);
+    sum += vi;
+  }
+  EXPECT_NEAR(sum, (hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z), 1e-10 * sum);
+}
