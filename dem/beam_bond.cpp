@@ -164,16 +164,9 @@ void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, d
   }
 }
 
-void BeamBondSet::accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const {
-  for (std::size_t b = 0; b < size(); ++b) {
-    if (broken_[b]) continue;
-    const Actions a = actions(b, p);
-    // The bond pulls DE i with -force_on_j and DE j with force_on_j; r_ji = -r_ij, so both
-    // ends get the same sym(r_ij (x) f_ij).
-    const Vec3 r = p.position[second_[b]] - p.position[first_[b]];
-    add_symmetric_product(virial[first_[b]], r, -a.force_on_j);
-    add_symmetric_product(virial[second_[b]], r, -a.force_on_j);
-  }
+void BeamBondSet::accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const {
+  for (std::size_t b = 0; b < size(); ++b)
+    if (!broken_[b]) add_bond_virial(p, first_[b], second_[b], -actions(b, p).force_on_j, branch, virial);  // the bond pulls i with -force_on_j
 }
 
 void BeamBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,

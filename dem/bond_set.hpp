@@ -55,6 +55,24 @@ void for_each_bond(const BondColouring& colouring, Body&& body) {
   }
 }
 
+// Adds the virial of a bond between DEs i and j, f_i the force on i, to both DEs. Per DE it is
+// sym(b (x) f) with b the branch vector from the DE's centre to the boundary of its cell on
+// the centre line, scaled by 2 to go with the 1 / (2 Omega) of seed Eq. 1: at the mid-point
+// (half), b = r_ij / 2 for both; on the radical plane (radical, the face of the Laguerre
+// cells), b_i = d_i r_ij / d with d_i = (d^2 + R_i^2 - R_j^2) / 2d, d_j = d - d_i, so that each
+// DE's virial is that of its own cell, and both add up to sym(r_ij (x) f) as before.
+inline void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                            std::span<Sym3> virial) {
+  const Vec3 r = p.position[j] - p.position[i];
+  double share_i = 1.0;  // 2 d_i / d
+  if (branch == VirialBranch::radical) {
+    const double d2 = norm2(r), ri = p.radius[i], rj = p.radius[j];
+    share_i = (d2 + ri * ri - rj * rj) / d2;
+  }
+  add_symmetric_product(virial[i], share_i * r, f_i);
+  add_symmetric_product(virial[j], (2.0 - share_i) * r, f_i);
+}
+
 class BondSet {
  public:
   virtual ~BondSet() = default;
@@ -74,12 +92,12 @@ class BondSet {
   virtual void scale_stiffness(std::span<const double> factor) = 0;
 
   // Failure. has_strength(): the law was given a strength, so find_failures() can report
-  // events (BBF for beams, maximum elongation for springs). accumulate_virial() adds
-  // sym(r_ij (x) f_ij) of every intact bond to both its DEs (RDEF, see failure.hpp).
+  // events (BBF for beams, maximum elongation for springs). accumulate_virial() adds every
+  // intact bond's sym(b (x) f) to both its DEs (RDEF, see failure.hpp; add_bond_virial).
   virtual bool has_strength() const = 0;
   virtual void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
                              std::vector<BreakEvent>& events) const = 0;
-  virtual void accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const = 0;
+  virtual void accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const = 0;
   virtual double bond_energy(std::size_t b, const ParticleSet& p) const = 0;
   // A broken bond keeps its place but its stiffness is zero: it carries no force from the
   // next force evaluation on, and the force loop needs no branch for it.

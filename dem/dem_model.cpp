@@ -261,7 +261,7 @@ void DemModel::apply_failures() {
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) {
     const ParticleSet& p = particles;
-    virial_stress(rdef_omega_, rdef_stress_);
+    virial_stress(rdef_omega_, rdef_->volume == RdefVolume::laguerre ? VirialBranch::radical : VirialBranch::half, rdef_stress_);
     if (rdef_->average == RdefAverage::bonded_neighbours) average_over_bonded_neighbours(rdef_stress_);
     rdef_equivalent_.resize(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
@@ -331,14 +331,15 @@ std::vector<double> DemModel::sphere_volume_shares(double compaction) const {
 
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {
   std::vector<Sym3> sigma;
-  virial_stress(sphere_volume_shares(compaction), sigma);
+  virial_stress(sphere_volume_shares(compaction), VirialBranch::half, sigma);
   return sigma;
 }
 
-void DemModel::virial_stress(const std::vector<double>& omega, std::vector<Sym3>& sigma) const {
-  // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij) (failure.hpp, seed Eq. 1).
+void DemModel::virial_stress(const std::vector<double>& omega, VirialBranch branch, std::vector<Sym3>& sigma) const {
+  // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij) (failure.hpp, seed Eq. 1), r_ij / 2 the
+  // branch (half), or the branch to the radical plane (bond_set.hpp).
   sigma.assign(particles.size(), Sym3{});
-  for (const auto& set : bond_sets_) set->accumulate_virial(particles, sigma);
+  for (const auto& set : bond_sets_) set->accumulate_virial(particles, branch, sigma);
   for (std::size_t i = 0; i < particles.size(); ++i)
     for (double& c : sigma[i]) c /= 2.0 * omega[i];
 }

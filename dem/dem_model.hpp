@@ -65,7 +65,8 @@ class DemModel {
 
   // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
   // stress reaches the DE's threshold; Omega_i = sphere volume / compaction, or the DE's
-  // Laguerre cell (`volume`, computed once at finalize in the reference configuration). A DE in one of
+  // Laguerre cell (`volume`, computed once at finalize in the reference configuration) with
+  // the bonds' virial taken on the cells' faces (VirialBranch::radical). A DE in one of
   // the listed groups takes that group's threshold (the first listed that holds it), any
   // other DE `threshold` (infinite: such DEs never fail by RDEF). With `average` =
   // bonded_neighbours the stress judged is the volume average over the DE and the DEs of its
@@ -131,8 +132,9 @@ class DemModel {
   void record_reactions();
   void apply_failures();
   void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
-  // Virial stress of every DE with the volume shares omega (m^3), into sigma (resized).
-  void virial_stress(const std::vector<double>& omega, std::vector<Sym3>& sigma) const;
+  // Virial stress of every DE with the volume shares omega (m^3) and the bonds' branch vectors
+  // to `branch`, into sigma (resized).
+  void virial_stress(const std::vector<double>& omega, VirialBranch branch, std::vector<Sym3>& sigma) const;
   std::vector<double> sphere_volume_shares(double compaction) const;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;

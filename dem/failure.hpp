@@ -7,7 +7,9 @@
 // r_ij = x_j - x_i, f_ij the force of the bond on DE i (towards j in tension, so tension is
 // positive), Omega_i the DE's volume share: sphere volume / compaction (so the shares add up to
 // the sample volume on average), or (our option, `volume: laguerre`) its Laguerre cell, which
-// adds up to it exactly and gives a small DE among large ones the room they leave it. When its equivalent stress (the largest principal stress, von Mises, or
+// adds up to it exactly and gives a small DE among large ones the room they leave it; with
+// Laguerre cells r_ij / 2 becomes the branch from the DE to the cell face (the radical plane,
+// through the contact point of touching spheres), so that sigma_i is the cell's own stress. When its equivalent stress (the largest principal stress, von Mises, or
 // the hydrostatic stress) reaches the threshold, every bond of the DE breaks; the DE stays and
 // interacts by contact.
 // Averaged RDEF (our option, not in the seed): the stress judged is
@@ -53,6 +55,9 @@ enum class RdefAverage : std::uint8_t { none, bonded_neighbours };
 // The DE's volume share Omega_i: its sphere volume / compaction, or its Laguerre cell
 // (laguerre_cells.hpp) in the sample's box.
 enum class RdefVolume : std::uint8_t { sphere, laguerre };
+// Where a DE's share of a bond's virial is taken (bond_set.hpp, add_bond_virial): half-way
+// along the bond (sphere volumes), or on the radical plane (Laguerre cells).
+enum class VirialBranch : std::uint8_t { half, radical };
 
 enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef };
 enum class FailureMode : std::uint8_t { tension, compression, bending, shear, torsion };

@@ -64,14 +64,9 @@ void SpringBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index,
   }
 }
 
-void SpringBondSet::accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const {
-  for (std::size_t b = 0; b < size(); ++b) {
-    if (broken_[b]) continue;
-    const Vec3 r = p.position[second_[b]] - p.position[first_[b]];
-    const Vec3 f_i = -force_on_j(b, p);
-    add_symmetric_product(virial[first_[b]], r, f_i);
-    add_symmetric_product(virial[second_[b]], r, f_i);
-  }
+void SpringBondSet::accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const {
+  for (std::size_t b = 0; b < size(); ++b)
+    if (!broken_[b]) add_bond_virial(p, first_[b], second_[b], -force_on_j(b, p), branch, virial);  // the bond pulls i with -force_on_j
 }
 
 void SpringBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,

@@ -29,7 +29,7 @@ class SpringBondSet final : public BondSet {
   bool has_strength() const override { return max_elongation_ > 0.0; }
   void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
                      std::vector<BreakEvent>& events) const override;
-  void accumulate_virial(const ParticleSet& p, std::span<Sym3> virial) const override;
+  void accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const override;
   double bond_energy(std::size_t b, const ParticleSet& p) const override;
 
  private:

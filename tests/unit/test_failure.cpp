@@ -134,6 +134,25 @@ TEST(Rdef, LaguerreSharesInACubicLatticeAreTheLatticeCube) {
   EXPECT_EQ(breaks(RdefVolume::laguerre, 1.01), 0u);
 }
 
+// The radical branch: two touching DEs, R 1 and 0.5 mm (d = 1.5 mm): the radical plane is at
+// d_0 = (d^2 + R_0^2 - R_1^2) / 2d = 1 mm from DE 0 (the contact point), so DE 0 gets
+// 2 d_0 f = 2 mm f and DE 1 2 d_1 f = 1 mm f (with the 1/2 of Eq. 1); half-way, both get d f.
+// Either way the two add up to 2 d f, the bond's whole virial.
+TEST(VirialStress, RadicalBranchEndsAtTheContactPoint) {
+  ParticleSet p;
+  p.add({0, 0, 0}, 1e-3, 1.0);
+  p.add({1.5e-3, 0, 0}, 0.5e-3, 1.0);
+  const Vec3 f_0{2.0, 0, 0};  // tension: DE 0 pulled towards DE 1
+  std::vector<Sym3> radical(2), half(2);
+  add_bond_virial(p, 0, 1, f_0, VirialBranch::radical, radical);
+  add_bond_virial(p, 0, 1, f_0, VirialBranch::half, half);
+  EXPECT_NEAR(radical[0][0], 2 * 1.0e-3 * 2.0, 1e-15);
+  EXPECT_NEAR(radical[1][0], 2 * 0.5e-3 * 2.0, 1e-15);
+  EXPECT_NEAR(half[0][0], 1.5e-3 * 2.0, 1e-15);
+  EXPECT_NEAR(half[1][0], 1.5e-3 * 2.0, 1e-15);
+  EXPECT_NEAR(radical[0][0] + radical[1][0], half[0][0] + half[1][0], 1e-15);
+}
+
 TEST(Rdef, BreaksEveryBondOfTheOverloadedDeAndCountsTheirEnergyAsFracture) {
   DemModel model;
   const double R = 1e-3;
