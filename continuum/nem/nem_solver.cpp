@@ -303,28 +303,32 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       // The part around corner m: triangles (c, mid(m-1, m), p_m) and (c, p_m, mid(m, m+1)).
       FaceParts parts;
       const auto from = f.tag >= 0 && f.tag < i ? shared.find({f.tag, i}) : shared.end();
-      if (from != shared.end()) {
+      const bool taken = from != shared.end();
+      if (taken) {
         parts = std::move(from->second);
         for (Flux& flux : parts.flux)
           for (auto& [J, v] : flux) v = -v;
         shared.erase(from);
         f.pts = parts.pts;
-      } else {
+      }
+      const Vec3 c = vertex_centre(f);
+      const size_t k = f.pts.size();
+      const auto midpoints = [&](size_t m) {  // of the edges before and after corner m
+        return std::pair{0.5 * (f.pts[(m + k - 1) % k] + f.pts[m]), 0.5 * (f.pts[m] + f.pts[(m + 1) % k])};
+      };
+      if (!taken) {
         parts.pts = f.pts;
-        parts.flux.resize(f.pts.size());
-        const Vec3 c = vertex_centre(f);
+        parts.flux.resize(k);
         const int plane = f.tag >= 0 ? -1 : -1 - f.tag;
-        const size_t k = f.pts.size();
         for (size_t m = 0; m < k; ++m) {
-          const Vec3 &p = f.pts[m], before = 0.5 * (f.pts[(m + k - 1) % k] + p), after = 0.5 * (p + f.pts[(m + 1) % k]);
+          const auto [before, after] = midpoints(m);
+          const Vec3& p = f.pts[m];
           add_flux(c, before, p, 0.5 * norm(cross(before - c, p - c)) * f.n, plane, parts.flux[m]);
           add_flux(c, p, after, 0.5 * norm(cross(p - c, after - c)) * f.n, plane, parts.flux[m]);
         }
         if (f.tag > i) shared[{i, f.tag}] = parts;
       }
-      const Vec3 c = vertex_centre(f);
       const double height = dot(c - X[i], f.n);  // of x_i over the face plane (>= 0)
-      const size_t k = f.pts.size();
       // The polygon's turning sense about the outward normal: +1 counter-clockwise.
       Vec3 turning{};
       for (size_t m = 0; m < k; ++m) turning += cross(f.pts[m] - c, f.pts[(m + 1) % k] - c);
@@ -333,7 +337,8 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       for (size_t m = 0; m < k; ++m) id[m] = vertex_id(f.pts[m]);
       if (sub.size() < vertex.size()) sub.resize(vertex.size());
       for (size_t m = 0; m < k; ++m) {
-        const Vec3 &p = f.pts[m], before = 0.5 * (f.pts[(m + k - 1) % k] + p), after = 0.5 * (p + f.pts[(m + 1) % k]);
+        const auto [before, after] = midpoints(m);
+        const Vec3& p = f.pts[m];
         SubCell& s_m = sub[id[m]];
         s_m.flux.insert(s_m.flux.end(), parts.flux[m].begin(), parts.flux[m].end());
         for (const auto& [a, b] : {std::pair{before, p}, std::pair{p, after}}) {
