@@ -362,7 +362,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
     for (const SubCell& sk : sub) volume += sk.volume;
     if (!(volume > 0)) throw RunError("nem: empty Voronoi cell at node " + std::to_string(i));
     cell_volume_[i] = volume;
-    // A thin sub-cell (|V_K| < 1e-3 |V_i|: a short cell edge, many left by nearly cospherical
+    // A thin sub-cell (|V_K| < 1e-2 |V_i|: a short cell edge, many left by nearly cospherical
     // nodes; or a corner where the node itself sits) has a surface-to-volume ratio that amplifies
     // round-off in its gradients (seen: 2e-11 in grad x at |V_K| ~ 1e-6 |V_i|), so it is merged
     // into the cell's largest sub-cell; a union of closed smoothing domains is one.
