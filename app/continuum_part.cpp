@@ -55,6 +55,7 @@ class Part final : public ContinuumPart {
     settings.materials.push_back({"", read_material(section.child("material"))});
     static constexpr std::string_view shapes[] = {"sibson", "laplace"};
     settings.shape_functions = section.choice_or("shape_functions", "sibson", shapes);
+    settings.nem_stabilization = section.number_or("stabilization", 1.0, Range::positive(), "1");
     settings.petsc_options = section.string_or("petsc_options", "") + " " + extra_petsc_options;
     static constexpr std::string_view analyses[] = {"explicit", "static"};
     static_ = section.choice_or("analysis", "explicit", analyses) == "static";

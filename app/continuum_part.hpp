@@ -10,6 +10,7 @@
 //     material: {E [Pa], nu, density [kg/m^3]}
 //             | {model: transversely_isotropic, E_L, E_T, nu_LT, nu_TT, G_LT [Pa], axis, density}
 //     shape_functions: sibson | laplace           (nem)
+//     stabilization: 1                            (nem: MSCNI's a, continuum/nem/nem_solver.hpp)
 //     petsc_options: "-ksp_type cg -pc_type gamg" (static solves; --petsc on the command line adds)
 //     analysis: explicit | static
 //     boundary:

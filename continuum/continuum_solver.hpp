@@ -52,6 +52,7 @@ struct ContinuumSettings {
   std::vector<RegionMaterial> materials;
   std::string petsc_options;              // given to PetscSession on the first continuum built
   std::string shape_functions = "sibson";  // nem only: "sibson" or "laplace"
+  double nem_stabilization = 1.0;          // nem only: MSCNI's a (nem_solver.hpp), > 0
 };
 
 class ContinuumSolver {

@@ -179,6 +179,10 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
     throw InputError("nem: shape_functions must be 'sibson' or 'laplace', got '" + settings.shape_functions + "'");
   Geometry& g = *geo_;
   g.laplace = settings.shape_functions == "laplace";
+  if (!(settings.nem_stabilization > 0.0))
+    throw InputError("nem: stabilization must be > 0 (MSCNI's a; 1 integrates each sub-cell), got " +
+                     std::to_string(settings.nem_stabilization));
+  const double root_a = std::sqrt(settings.nem_stabilization);
   const std::vector<Vec3>& X = nodes();
   const int n = num_nodes();
   g.x = &X;
@@ -377,19 +381,28 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
       into.moment += sub[k].moment;
       into.flux.insert(into.flux.end(), sub[k].flux.begin(), sub[k].flux.end());
     }
+    // MSCNI's a (header): point K's gradients g_K' = g_L + sqrt(a) (g_K - g_L), g_L the cell's,
+    // so that sum_K |V_LK| e'_K.C e'_K is the header's energy (the cross terms vanish, as
+    // sum_K |V_LK| (g_K - g_L) = 0). With a = 1 (g_K' = g_K) a point couples its own nodes only.
+    std::map<int, Vec3> cell_flux;
+    for (size_t k = 0; k < sub.size(); ++k)
+      if (!merged(k))
+        for (const auto& [J, value] : sub[k].flux) cell_flux[J] += value;
     for (size_t k = 0; k < sub.size(); ++k) {
       if (merged(k)) continue;
-      SubCell& sk = sub[k];
-      std::sort(sk.flux.begin(), sk.flux.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+      const SubCell& sk = sub[k];
+      std::map<int, Vec3> own_flux;
+      for (const auto& [J, value] : sk.flux) own_flux[J] += value;
       points_.x.push_back(sk.moment / sk.volume);
       points_.volume.push_back(sk.volume);
       points_.material.push_back(node_material[i]);
-      for (size_t e = 0; e < sk.flux.size();) {
-        Vec3 sum{};
-        const int J = sk.flux[e].first;
-        for (; e < sk.flux.size() && sk.flux[e].first == J; ++e) sum += sk.flux[e].second;
+      for (const auto& [J, flux] : cell_flux) {
+        const auto own = own_flux.find(J);
+        if (root_a == 1.0 && own == own_flux.end()) continue;
+        const Vec3 g_sub = own == own_flux.end() ? Vec3{} : own->second / sk.volume;
+        const Vec3 g_cell = flux / volume;
         points_.node.push_back(J);
-        points_.grad.push_back(sum / sk.volume);
+        points_.grad.push_back(root_a == 1.0 ? g_sub : g_cell + root_a * (g_sub - g_cell));
       }
       points_.offset.push_back(static_cast<int>(points_.node.size()));
     }

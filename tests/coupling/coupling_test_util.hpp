@@ -88,10 +88,12 @@ inline std::string write_box_mesh(const std::string& name, double x0, int nx, do
 }
 
 inline std::unique_ptr<continuum::ContinuumSolver> make_continuum(const std::string& method, const std::string& mesh,
-                                                                  double E, double nu, double rho) {
+                                                                  double E, double nu, double rho,
+                                                                  double nem_stabilization = 1.0) {
   continuum::ContinuumSettings s;
   s.mesh = {mesh, 0.0, 1, {}};
   s.materials = {{"", continuum::Material::isotropic(E, nu, rho)}};
+  s.nem_stabilization = nem_stabilization;
   return continuum::make_continuum_solver(method, s);
 }
 
