@@ -2,6 +2,7 @@
 // DEM bars that match them (same stiffness per unit length and mass per node).
 #pragma once
 #include <gtest/gtest.h>
+#include <unistd.h>  // getpid
 
 #include <array>
 #include <cmath>
@@ -65,7 +66,9 @@ inline std::string write_box_mesh(const std::string& name, double x0, int nx, do
         if (on) tris.push_back({side + 1, f[0], f[1], f[2]});
       }
     }
-  const fs::path tmp = dir / (name + ".msh.tmp");
+  // Our own temporary file: tests running side by side (ctest -j, or two checkouts) may write
+  // the same mesh; sharing one temporary let one truncate the file another was writing.
+  const fs::path tmp = dir / (name + ".msh.tmp." + std::to_string(::getpid()));
   {
     std::ofstream out(tmp);
     out.precision(17);
