@@ -83,12 +83,13 @@ class Part final : public ContinuumPart {
   void step(double dt) override { coupled_ ? coupled_->step(dt) : solver_->step(dt); }
   bool is_coupled() const override { return coupled_ != nullptr; }
   void set_affine_displacement(const std::array<Vec3, 3>& H) override {
-    auto& u = solver_->displacement();
     const auto& x = solver_->nodes();
+    continuum::Field u(3 * x.size());
     for (std::size_t n = 0; n < x.size(); ++n) {
       const Vec3 hx = rows_times(H, x[n]);
       for (int c = 0; c < 3; ++c) u[3 * n + c] = hx[c];
     }
+    solver_->set_initial_displacement(u);
   }
   std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
   double coupling_work() const override { return coupled_ ? coupled_->energies().coupling_work : 0.0; }

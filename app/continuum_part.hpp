@@ -19,6 +19,8 @@
 //       - {group, type: velocity, value [m/s], rise [s], duration [s]}  velocity ramped up over
 //         `rise` (linear), imposed until `duration`, then the displacement is held
 //       - {group, type: traction, value [Pa]}               on a surface group
+//     Displacements are imposed on top of the initial state (initial_strain), as the DEM's
+//     conditions move DEs from where they start: `fixed` holds a pre-strained face in place.
 //
 // Coupled to the DEM by the Arlequin method (coupling/) when the case has a `coupling:` section:
 //   coupling:

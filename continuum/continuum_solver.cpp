@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "common/error.hpp"
 #include "continuum/petsc_session.hpp"
@@ -63,17 +64,24 @@ void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> componen
       if (!components[c]) continue;
       const int dof = 3 * n + c;
       auto it = std::find_if(fixed_.begin(), fixed_.end(), [&](const Fixed& f) { return f.dof == dof; });
-      if (it != fixed_.end())
-        it->g = g;  // the later BC on a shared node wins
-      else
-        fixed_.push_back({dof, g});
+      if (it == fixed_.end()) it = fixed_.insert(fixed_.end(), {dof, g, initial_u_.empty() ? 0.0 : initial_u_[dof]});
+      it->g = g;  // the later BC on a shared node wins
       is_fixed_[dof] = 1;
-      u_[dof] = g(nodes()[n], t_)[c];
+      u_[dof] = prescribed(*it, t_);
     }
 }
 
+void ContinuumSolver::set_initial_displacement(const Field& u0) {
+  if (u0.size() != u_.size()) throw std::invalid_argument("set_initial_displacement: one value per dof expected");
+  u_ = initial_u_ = u0;
+  for (Fixed& f : fixed_) {
+    f.start = u0[f.dof];
+    u_[f.dof] = prescribed(f, t_);
+  }
+}
+
 double ContinuumSolver::prescribed(const Fixed& f, double t) const {
-  return f.g(nodes()[f.dof / 3], t)[f.dof % 3];
+  return f.start + f.g(nodes()[f.dof / 3], t)[f.dof % 3];
 }
 
 void ContinuumSolver::add_traction(const std::string& group, VectorFunction traction) {

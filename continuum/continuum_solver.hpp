@@ -71,8 +71,13 @@ class ContinuumSolver {
 
   virtual InterpolationOperator interpolation(const std::vector<Vec3>& points) const = 0;
 
-  // Fixes `components` of every node of `group` to g(X, t) (applied now and at every drift).
+  // Fixes `components` of every node of `group` to u0 + g(X, t) (applied now and at every
+  // drift), u0 the initial displacement (0 unless set_initial_displacement).
   void fix(const std::string& group, std::array<bool, 3> components, VectorFunction g);
+  // Starts from u0 (one value per dof): a pre-strained state. Essential conditions, set before
+  // or after, prescribe their g on top of it, as the DEM's boundary conditions move DEs from
+  // where they start.
+  void set_initial_displacement(const Field& u0);
   // Traction (force per area, function of position and time) on a 2D physical group.
   void add_traction(const std::string& group, VectorFunction traction);
 
@@ -141,6 +146,7 @@ class ContinuumSolver {
   struct Fixed {
     int dof;
     VectorFunction g;
+    double start = 0.0;  // the initial displacement of the dof, m
   };
   Voigt strain_at(int q, const Field& u) const;
   void add_external_force(Field& f) const;
@@ -150,6 +156,7 @@ class ContinuumSolver {
   std::vector<double> point_weight_;  // alpha(x_q) volume_q
   std::vector<double> mass_;
   std::vector<Fixed> fixed_;
+  Field initial_u_;  // set_initial_displacement's u0 (empty: zero)
   std::vector<char> is_fixed_;  // per dof
   std::vector<Traction> tractions_;
   Field u_, v_, f_;

@@ -1,5 +1,6 @@
 #include "coupling/multiplier_solver.hpp"
 
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -31,10 +32,16 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     // Jacobi scaling S A S, S = diag(A)^-1/2: rows of A differ by orders of magnitude (a
     // floored continuum mass on the overlap edge against a full one), and the pivot test below
     // is only meaningful on a unit diagonal.
+    // A row whose DEs and nodes are all held (inverse masses 0) is empty: nothing can move to
+    // meet it, so its multiplier is 0 (scale 0, unit pivot) rather than a singular A. Empty up
+    // to the round-off of the interpolation (measured: diagonals 1e-33 of the largest and less).
     Eigen::VectorXd scale = A.diagonal();
-    bool ok = scale.minCoeff() > 0.0;
-    if (ok) scale = scale.cwiseSqrt().cwiseInverse();
+    const double empty_row = 1e-20 * scale.maxCoeff();
+    bool ok = scale.minCoeff() >= 0.0 && scale.maxCoeff() > 0.0;
+    if (ok) scale = scale.unaryExpr([empty_row](double d) { return d > empty_row ? 1.0 / std::sqrt(d) : 0.0; });
     Eigen::SparseMatrix<double> Acol = scale.asDiagonal() * A * scale.asDiagonal();  // column-major for the factor
+    for (Eigen::Index r = 0; r < scale.size(); ++r)
+      if (scale[r] == 0.0) Acol.coeffRef(r, r) = 1.0;
     nonzeros_ = Acol.nonZeros();
     auto f = std::make_unique<Factor>();
     if (ok) f->compute(Acol);

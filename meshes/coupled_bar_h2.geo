@@ -20,4 +20,9 @@ Transfinite Surface {:};
 Transfinite Volume {:};
 Physical Surface("probe") = {Surface In BoundingBox{xp - e, -e, -e, xp + e, w + e, w + e}};
 Physical Surface("right") = {Surface In BoundingBox{x1 - e, -e, -e, x1 + e, w + e, w + e}};
+// The four side faces: "lateral" (held in the static patch test, cases/patch_coupled).
+Physical Surface("lateral") = {Surface In BoundingBox{x0 - e, -e, -e, x1 + e, e, w + e},
+                               Surface In BoundingBox{x0 - e, w - e, -e, x1 + e, w + e, w + e},
+                               Surface In BoundingBox{x0 - e, -e, -e, x1 + e, w + e, e},
+                               Surface In BoundingBox{x0 - e, -e, w - e, x1 + e, w + e, w + e}};
 Physical Volume("bar") = {1, 2};
