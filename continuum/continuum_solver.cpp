@@ -64,8 +64,10 @@ void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> componen
       if (!components[c]) continue;
       const int dof = 3 * n + c;
       auto it = std::find_if(fixed_.begin(), fixed_.end(), [&](const Fixed& f) { return f.dof == dof; });
-      if (it == fixed_.end()) it = fixed_.insert(fixed_.end(), {dof, g, initial_u_.empty() ? 0.0 : initial_u_[dof]});
-      it->g = g;  // the later BC on a shared node wins
+      if (it == fixed_.end())
+        it = fixed_.insert(fixed_.end(), {dof, g, initial_u_.empty() ? 0.0 : initial_u_[dof]});
+      else
+        it->g = g;  // the later BC on a shared node wins
       is_fixed_[dof] = 1;
       u_[dof] = prescribed(*it, t_);
     }
