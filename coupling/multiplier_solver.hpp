@@ -5,9 +5,10 @@
 //    Jebahi et al., CMAME 255 (2013) section 3.3), per displacement component, with M the
 //    weighted lumped masses. A zero inverse mass marks a held dof (essential BC): it takes no
 //    correction. A row whose dofs are all held (a mediator node on a held face whose DEs are
-//    held too) is empty: its multiplier is 0. A is otherwise sparse SPD while the overlap and the masses do not change; it is factored
-//    once (Eigen SimplicialLDLT, fill-reducing AMD ordering) in the constructor and reused. When
-//    the three components have the same inverse masses one factor serves all three.
+//    held too) is empty: its multiplier is 0. A is otherwise sparse SPD while the overlap and
+//    the masses do not change; it is factored once (Eigen SimplicialLDLT, fill-reducing AMD
+//    ordering) in the constructor and reused. When the three components have the same inverse
+//    masses one factor serves all three.
 //  - project(vd, vc) solves A lambda = G_d vd + G_c vc and corrects
 //      vd -= M_d^-1 G_d^T lambda,  vc -= M_c^-1 G_c^T lambda,
 //    the M-orthogonal projection onto ker G (after it G_d vd + G_c vc = 0 to round-off).

@@ -1,0 +1,80 @@
+// MultiplierSolver on hand-built operators: the projection onto ker G against its closed form,
+// and a row whose dofs are all held (empty row, multiplier 0) beside rows that are not.
+#include <gtest/gtest.h>
+
+#include "common/error.hpp"
+#include "coupling/multiplier_solver.hpp"
+
+using namespace arlequin;
+using namespace arlequin::coupling;
+
+namespace {
+
+// Fine mediator with every DE on a node: G_d = S, G_c = -S (N = I), S = diag(w). Row i then
+// reads w_i (vd_i - vc_i) = 0, A_ii = w_i^2 (md_i + mc_i), and the projection has the closed form
+//   lambda_i = (vd_i - vc_i) / (w_i (md_i + mc_i)),  vd_i, vc_i -> (md_i^-1 vd_i + mc_i^-1 vc_i) / (md_i^-1 + mc_i^-1)
+// (momentum-weighted mean), with md, mc the inverse masses.
+CouplingOperators one_to_one(const std::vector<double>& w) {
+  const int n = static_cast<int>(w.size());
+  CouplingOperators ops;
+  for (int i = 0; i < n; ++i) ops.particles.push_back(static_cast<std::uint32_t>(i));
+  ops.N.resize(n, n);
+  ops.Gd.resize(n, n);
+  ops.Gc.resize(n, n);
+  for (int i = 0; i < n; ++i) {
+    ops.N.insert(i, i) = 1.0;
+    ops.Gd.insert(i, i) = w[i];
+    ops.Gc.insert(i, i) = -w[i];
+  }
+  return ops;
+}
+
+}  // namespace
+
+TEST(CouplingMultiplierSolver, ProjectionIsTheMomentumWeightedMeanAndAHeldRowIsEmpty) {
+  const std::vector<double> w{0.5, 1.0, 2.0, 0.25};
+  const CouplingOperators ops = one_to_one(w);
+  // Row 0: DE and node held (inverse masses 0): empty. Row 2: DE held, node free. Rows 1, 3 free.
+  const std::vector<double> md{0.0, 2.0, 0.0, 4.0};
+  std::vector<double> mc;  // per dof; rows 1 and 3 carry different masses per component
+  const double node_inv[4] = {0.0, 1.0, 3.0, 0.5};
+  for (int i = 0; i < 4; ++i)
+    for (int c = 0; c < 3; ++c) mc.push_back(node_inv[i] * (c == 1 && i != 0 ? 2.0 : 1.0));
+  const MultiplierSolver solver(ops, md, mc);
+  EXPECT_EQ(solver.factorizations(), 2);  // y differs from x, z reuses x's factor
+
+  Matrix3 vd(4, 3), vc(4, 3), dd, dc, lambda;
+  vd << 1, 2, 3, -1, 0.5, 2, 4, -3, 1, 0.2, 0.3, -0.7;
+  vc << -2, 1, 0, 3, 1.5, -1, 2, 2, 2, -0.4, 0.9, 0.1;
+  const Matrix3 vd0 = vd, vc0 = vc;
+  solver.project(vd, vc, dd, dc, lambda);
+  for (int i = 0; i < 4; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double a = md[i], b = mc[3 * i + c];
+      if (a + b == 0.0) {  // the empty row: nothing moves, no multiplier
+        EXPECT_EQ(lambda(i, c), 0.0);
+        EXPECT_EQ(vd(i, c), vd0(i, c));
+        EXPECT_EQ(vc(i, c), vc0(i, c));
+        continue;
+      }
+      EXPECT_NEAR(lambda(i, c), (vd0(i, c) - vc0(i, c)) / (w[i] * (a + b)), 1e-12) << i << c;
+      // A held side keeps its velocity (inverse mass 0 means infinite mass in the mean).
+      const double mean = a == 0.0 ? vd0(i, c) : b == 0.0 ? vc0(i, c) : (vd0(i, c) / a + vc0(i, c) / b) / (1 / a + 1 / b);
+      EXPECT_NEAR(vd(i, c), mean, 1e-12) << i << c;
+      EXPECT_NEAR(vc(i, c), mean, 1e-12) << i << c;
+      EXPECT_NEAR(dd(i, c), vd0(i, c) - vd(i, c), 1e-12);
+      EXPECT_NEAR(dc(i, c), vc0(i, c) - vc(i, c), 1e-12);
+    }
+}
+
+TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
+  // Two rows over one free DE and no node: A = m [w0^2, w0 w1; w0 w1, w1^2] is singular (rank 1).
+  CouplingOperators ops;
+  ops.particles = {0};
+  ops.N.resize(1, 1);
+  ops.Gd.resize(2, 1);
+  ops.Gc.resize(2, 1);
+  ops.Gd.insert(0, 0) = 1.0;
+  ops.Gd.insert(1, 0) = 2.0;
+  EXPECT_THROW(MultiplierSolver(ops, {1.0}, {1.0, 1.0, 1.0}), RunError);
+}
