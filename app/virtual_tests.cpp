@@ -548,6 +548,7 @@ FailurePlan FailurePlan::read(std::optional<CaseNode> node) {
   f.transits = node->number_or("transits", f.transits, Range::positive(), "transit times");
   f.max_strain_factor = node->number_or("max_strain_factor", f.max_strain_factor, Range::at_least(1.0), "1");
   f.stop_below = node->number_or("stop_below", f.stop_below, Range::open_between(0.0, 1.0), "1");
+  f.stop_after = node->number_or("stop_after", f.stop_after, Range::non_negative(), "transit times");
   f.damping = node->number_or("damping", f.damping, Range::non_negative(), "1");
   f.rise = node->number_or("rise", f.rise, Range::non_negative(), "transit times");
   f.rows_per_transit = node->number_or("rows_per_transit", f.rows_per_transit, Range::at_least(2.0), "1");
@@ -558,8 +559,20 @@ FailurePlan FailurePlan::read(std::optional<CaseNode> node) {
 
 std::string FailurePlan::describe() const {
   return "expected strain " + shortest(expected_strain) + " after " + shortest(transits) + " T (rise " + shortest(rise) +
-         " T), end below " + shortest(stop_below) + " of the peak or at " + shortest(max_strain_factor) +
+         " T), end below " + shortest(stop_below) + " of the peak" +
+         (stop_after > 0.0 ? " for " + shortest(stop_after) + " T" : std::string()) + " or at " + shortest(max_strain_factor) +
          " x the expected strain, damping " + shortest(damping) + " of critical, " + shortest(rows_per_transit) + " rows per T";
+}
+
+FailureStop::FailureStop(const FailurePlan& plan)
+    : stop_below_(plan.stop_below),
+      min_strain_(0.2 * plan.expected_strain),
+      rows_needed_(std::max(1L, std::lround(std::ceil(plan.stop_after * plan.rows_per_transit)))) {}
+
+bool FailureStop::after_row(double stress, double strain) {
+  peak_ = std::max(peak_, stress);
+  rows_below_ = strain > min_strain_ && stress < stop_below_ * peak_ ? rows_below_ + 1 : 0;
+  return rows_below_ >= rows_needed_;
 }
 
 FailureTestResult run_failure_test(const std::filesystem::path& case_file, const SceneOptions& options, const LoadCase& load,
@@ -603,7 +616,7 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
     generated.insert(generated.end(), {"output.fields=[particles, bonds]", "output.fields_every=" + number_text(end / plan.frames)});
 
   // The stress on the moved face, row by row; stop once it has fallen well below its peak.
-  double peak = 0.0;
+  FailureStop stop(plan);
   RunOptions run_options;
   const std::string moved = displacement_column(a, true), held = displacement_column(a, false);
   run_options.stop_after_row = [&](const std::vector<std::pair<std::string, double>>& row) -> std::string {
@@ -613,10 +626,9 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
       if (name == moved) upper = value;
       if (name == held) lower = value;
     }
-    const double stress = force / area, strain = (upper - lower) / gauge;
-    peak = std::max(peak, stress);
-    if (strain > 0.2 * plan.expected_strain && stress < plan.stop_below * peak)
-      return "the stress fell below " + shortest(plan.stop_below) + " of its peak";
+    if (stop.after_row(force / area, (upper - lower) / gauge))
+      return "the stress fell below " + shortest(plan.stop_below) + " of its peak" +
+             (plan.stop_after > 0.0 ? " for " + shortest(plan.stop_after) + " T" : std::string());
     return {};
   };
   const auto [scene, run] = setup.run(case_file, generated, run_options);

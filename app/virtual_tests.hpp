@@ -113,14 +113,18 @@ struct VirtualTestResult {
 // (same T as above). Damping is light: mass-proportional damping of a sample stretched at a
 // constant rate makes the stress differ between the faces by about pi zeta E (strain per
 // transit); zeta 0.05 and 4e-4 per transit keep that below 1 % of a failure stress at a
-// strain of 1e-2. The run ends when the stress on the moved face has fallen below
-// stop_below of its peak (past 0.2 expected_strain), or at max_strain_factor expected_strain.
+// strain of 1e-2. The run ends when the stress on the moved face has stayed below stop_below
+// of its peak (past 0.2 expected_strain) for stop_after transit times (0: at the first output
+// row below), or at max_strain_factor expected_strain. A brittle break makes the stress ring
+// through zero for a few transits; to follow the damage after the peak down to a small
+// stop_below, give stop_after a few transits so that a dip of the ringing does not end the run.
 // Failure stress = peak of F_moved / area; failure strain = the gauge strain at that row.
 struct FailurePlan {
   double expected_strain = 1.0e-2;
   double transits = 25.0;
   double max_strain_factor = 2.0;
   double stop_below = 0.5;
+  double stop_after = 0.0;       // transit times
   double damping = 0.05;
   double rise = 1.0;             // transit times
   double rows_per_transit = 20.0;
@@ -129,6 +133,21 @@ struct FailurePlan {
   // Reads an optional mapping with the fields above (absent ones keep their defaults).
   static FailurePlan read(std::optional<CaseNode> node);
   std::string describe() const;
+};
+
+// The end rule of a test to failure (FailurePlan), fed one output row at a time.
+class FailureStop {
+ public:
+  explicit FailureStop(const FailurePlan& plan);
+  // True once the stress (Pa) has been below stop_below x its peak so far, at strains above
+  // 0.2 expected_strain, for the plan's stop_after transits of consecutive rows (at least one).
+  bool after_row(double stress, double strain);
+
+ private:
+  double stop_below_, min_strain_;
+  long rows_needed_;
+  double peak_ = 0.0;
+  long rows_below_ = 0;
 };
 
 struct FailureTestResult {

@@ -219,6 +219,31 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
   }
 }
 
+// The end rule of a test to failure: a brittle break rings through zero; with stop_after the
+// run goes on until the stress stays low, without it the first low row ends it.
+TEST(RevFailure, EndRuleWaitsOutTheRingingOfABreakWhenAsked) {
+  app::FailurePlan plan;
+  plan.expected_strain = 1e-2;
+  plan.stop_below = 0.1;
+  plan.rows_per_transit = 4;
+  const std::vector<std::pair<double, double>> rows{  // stress Pa, strain
+      {0.0, 1e-3},   {0.0, 1.5e-3},  // low, but before 0.2 expected_strain: never the end
+      {1.0e9, 5e-3}, {1.3e9, 1e-2},  // the peak
+      {-0.2e9, 1.01e-2}, {0.5e9, 1.02e-2}, {-0.1e9, 1.03e-2}, {0.05e9, 1.04e-2}, {0.02e9, 1.05e-2},
+      {0.01e9, 1.06e-2}};
+  const auto first_stop = [&](const app::FailurePlan& p) {
+    app::FailureStop stop(p);
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (stop.after_row(rows[i].first, rows[i].second)) return static_cast<int>(i);
+    return -1;
+  };
+  EXPECT_EQ(first_stop(plan), 4);  // stop_after 0: the first dip of the ringing
+  plan.stop_after = 1.0;           // one transit = 4 rows in a row below 0.13 GPa
+  EXPECT_EQ(first_stop(plan), 9);
+  plan.stop_after = 2.0;
+  EXPECT_EQ(first_stop(plan), -1);
+}
+
 TEST(VirtualTests, CompositeSpecNeedsItsFourTests) {
   const auto dir = test::scratch_dir("virtual_tests_bad_spec");
   homogeneous_case(dir);
