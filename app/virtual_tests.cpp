@@ -559,9 +559,12 @@ FailurePlan FailurePlan::read(std::optional<CaseNode> node) {
 
 std::string FailurePlan::describe() const {
   return "expected strain " + shortest(expected_strain) + " after " + shortest(transits) + " T (rise " + shortest(rise) +
-         " T), end below " + shortest(stop_below) + " of the peak" +
-         (stop_after > 0.0 ? " for " + shortest(stop_after) + " T" : std::string()) + " or at " + shortest(max_strain_factor) +
+         " T), end " + end_rule() + " or at " + shortest(max_strain_factor) +
          " x the expected strain, damping " + shortest(damping) + " of critical, " + shortest(rows_per_transit) + " rows per T";
+}
+
+std::string FailurePlan::end_rule() const {
+  return "below " + shortest(stop_below) + " of the peak" + (stop_after > 0.0 ? " for " + shortest(stop_after) + " T" : std::string());
 }
 
 FailureStop::FailureStop(const FailurePlan& plan)
@@ -627,8 +630,7 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
       if (name == held) lower = value;
     }
     if (stop.after_row(force / area, (upper - lower) / gauge))
-      return "the stress fell below " + shortest(plan.stop_below) + " of its peak" +
-             (plan.stop_after > 0.0 ? " for " + shortest(plan.stop_after) + " T" : std::string());
+      return "the stress fell " + plan.end_rule();
     return {};
   };
   const auto [scene, run] = setup.run(case_file, generated, run_options);

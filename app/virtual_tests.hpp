@@ -133,6 +133,7 @@ struct FailurePlan {
   // Reads an optional mapping with the fields above (absent ones keep their defaults).
   static FailurePlan read(std::optional<CaseNode> node);
   std::string describe() const;
+  std::string end_rule() const;  // "below 0.5 of the peak[ for 3 T]", for describe and the stop reason
 };
 
 // The end rule of a test to failure (FailurePlan), fed one output row at a time.
