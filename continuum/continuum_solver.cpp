@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "continuum/petsc_session.hpp"
 
 namespace arlequin::continuum {
@@ -49,7 +50,24 @@ ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings) : mesh_(Mesh
 
 ContinuumSolver::~ContinuumSolver() = default;
 
-void ContinuumSolver::finish_setup() { set_weight([](const Vec3&) { return 1.0; }); }
+void ContinuumSolver::finish_setup() {
+  // Counting sort of the point entries by node, points in increasing order within a node.
+  const int nq = static_cast<int>(points_.x.size());
+  by_node_.offset.assign(static_cast<size_t>(num_nodes()) + 1, 0);
+  for (int J : points_.node) ++by_node_.offset[J + 1];
+  for (int J = 0; J < num_nodes(); ++J) by_node_.offset[J + 1] += by_node_.offset[J];
+  by_node_.point.resize(points_.node.size());
+  by_node_.grad.resize(points_.node.size());
+  std::vector<int> next(by_node_.offset.begin(), by_node_.offset.end() - 1);
+  for (int q = 0; q < nq; ++q)
+    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+      const int slot = next[points_.node[k]]++;
+      by_node_.point[slot] = q;
+      by_node_.grad[slot] = points_.grad[k];
+    }
+  point_stress_.assign(static_cast<size_t>(nq), Voigt::Zero());
+  set_weight([](const Vec3&) { return 1.0; });
+}
 
 void ContinuumSolver::set_weight(ScalarFunction alpha) {
   alpha_ = std::move(alpha);
@@ -125,18 +143,30 @@ Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
   return e;
 }
 
+// f_int = sum_q w_q B_q^T C_q B_q u in two loops: the weighted stress s_q = w_q C_q B_q u of
+// every point, then per node J the sum of B_qJ^T s_q over the points that hold it (by_node_).
+// Each loop writes only its own entries, so both run over threads as they are; each is one pass
+// over the entries (points_.node), the measure of its work.
 void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
-  f_int.assign(u.size(), 0.0);
-  const int nq = static_cast<int>(points_.x.size());
-  for (int q = 0; q < nq; ++q) {
-    const Voigt s = point_weight_[q] * (materials_[points_.material[q]].C * strain_at(q, u));
-    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
-      const Vec3& g = points_.grad[k];
-      double* fj = &f_int[3 * static_cast<size_t>(points_.node[k])];
-      fj[0] += g.x * s[0] + g.z * s[4] + g.y * s[5];
-      fj[1] += g.y * s[1] + g.z * s[3] + g.x * s[5];
-      fj[2] += g.z * s[2] + g.y * s[3] + g.x * s[4];
+  f_int.resize(u.size());
+  const long nq = static_cast<long>(points_.x.size()), nn = num_nodes();
+  const bool parallel = static_cast<long>(points_.node.size()) > parallel_threshold;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long q = 0; q < nq; ++q)
+    point_stress_[q] = point_weight_[q] * (materials_[points_.material[q]].C * strain_at(static_cast<int>(q), u));
+#pragma omp parallel for schedule(static) if (parallel)
+  for (long J = 0; J < nn; ++J) {
+    double fx = 0, fy = 0, fz = 0;
+    for (int k = by_node_.offset[J]; k < by_node_.offset[J + 1]; ++k) {
+      const Vec3& g = by_node_.grad[k];
+      const Voigt& s = point_stress_[by_node_.point[k]];
+      fx += g.x * s[0] + g.z * s[4] + g.y * s[5];
+      fy += g.y * s[1] + g.z * s[3] + g.x * s[5];
+      fz += g.z * s[2] + g.y * s[3] + g.x * s[4];
     }
+    f_int[3 * J] = fx;
+    f_int[3 * J + 1] = fy;
+    f_int[3 * J + 2] = fz;
   }
 }
 

@@ -152,8 +152,21 @@ class ContinuumSolver {
   void add_external_force(Field& f) const;
   double prescribed(const Fixed& f, double t) const;
 
+  // The points' gradients regrouped by node (finish_setup): node J's internal force is the sum
+  // over its entries (q, g) of g . s_q, s_q the weighted stress of point q, so internal_force
+  // runs over points and then over nodes, each loop free of write conflicts between threads.
+  struct PointsByNode {
+    std::vector<int> offset{0};
+    std::vector<int> point;
+    std::vector<Vec3> grad;
+  };
+
   ScalarFunction alpha_;
   std::vector<double> point_weight_;  // alpha(x_q) volume_q
+  PointsByNode by_node_;
+  // internal_force's s_q, kept between calls so that a step allocates nothing (one caller at a
+  // time per solver, as for every other state).
+  mutable std::vector<Voigt> point_stress_;
   std::vector<double> mass_;
   std::vector<Fixed> fixed_;
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)

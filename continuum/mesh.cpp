@@ -1,6 +1,9 @@
 #include "continuum/mesh.hpp"
 
 #include <gmsh.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -23,13 +26,24 @@ double signed_volume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
 // gmsh keeps global state: one mesh at a time, with its own initialize/finalize around it.
 std::mutex g_gmsh_mutex;
 
+// General.NumThreads is applied with omp_set_num_threads, for the whole process: the scope puts
+// back the thread count it found, or every OpenMP loop after a mesh load (DEM and continuum
+// alike) would run on one thread.
 struct GmshScope {
   GmshScope() {
     gmsh::initialize();
     gmsh::option::setNumber("General.Terminal", 0);
     gmsh::option::setNumber("General.NumThreads", 1);  // reproducible meshes
   }
-  ~GmshScope() { gmsh::finalize(); }
+  ~GmshScope() {
+    gmsh::finalize();
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#endif
+  }
+#ifdef _OPENMP
+  int threads = omp_get_max_threads();  // initialised before the constructor's body runs
+#endif
 };
 
 // MeshSource::left_out on the raw arrays; returns the number of tetrahedra dropped.

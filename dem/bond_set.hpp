@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "common/parallel.hpp"
 #include "dem/failure.hpp"
 #include "dem/particles.hpp"
 
@@ -41,9 +42,6 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
   for (std::size_t k = 0; k < order.size(); ++k) sorted[k] = v[order[k]];
   v.swap(sorted);
 }
-
-// Loops shorter than this run on one thread: below it, starting threads costs more than it saves.
-inline constexpr long parallel_threshold = 4096;
 
 // Runs body(b) for every bond, colour by colour, each colour split over threads.
 template <class Body>

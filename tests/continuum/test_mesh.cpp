@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "common/error.hpp"
 #include "continuum/mesh.hpp"
@@ -20,6 +23,19 @@ TEST(ContinuumMesh, GeoIsMeshedWithNamedGroups) {
   EXPECT_GT(m.group("boundary").triangles.size(), m.group("xmin").triangles.size());
   EXPECT_EQ(m.boundary_triangles().size(), m.group("boundary").triangles.size());
 }
+
+#ifdef _OPENMP
+// gmsh applies its General.NumThreads (1, for reproducible meshes) to the whole process; a mesh
+// load must leave the OpenMP thread count as it found it, or every later parallel loop of the
+// scene (DEM bonds, continuum forces) runs on one thread.
+TEST(ContinuumMesh, LoadingAMeshKeepsTheOpenMpThreadCount) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(3);
+  Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1, {}});
+  EXPECT_EQ(omp_get_max_threads(), 3);
+  omp_set_num_threads(before);
+}
+#endif
 
 TEST(ContinuumMesh, QuadraticEdgeNodesAreMidpoints) {
   const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.5, 2, {}});

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "continuum/nem/nem_solver.hpp"
 #include "convergence_util.hpp"
@@ -160,4 +163,37 @@ TEST(ContinuumNem, StabilizationScalesTheWithinCellEnergy) {
                four = alternating_mode_energy_ratio("nem", 4.0);
   EXPECT_NEAR((four - one) / (one - quarter), 4.0, 1e-9);
   EXPECT_GT(four - one, 1.5);  // the within-cell part carries most of the mode
+}
+
+// internal_force sums per node over the points that hold it (ContinuumSolver::internal_force).
+// Checked against the bilinear form, which the strain energy evaluates point by point:
+// f_int(u).v = a(u, v) = (E(u + v) - E(u - v)) / 2 with E(w) = a(w, w) / 2; and the same to the
+// bit on one and on two threads, as every node's sum runs in a fixed order.
+TEST(ContinuumNem, InternalForceIsTheBilinearFormOnAnyThreadCount) {
+  auto s = make_nem(0.3, "sibson", 1.9);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uni(-1e-3, 1e-3);
+  Field u(s->displacement().size()), v(u.size());
+  for (double& x : u) x = uni(rng);
+  for (double& x : v) x = uni(rng);
+  const auto energy_of = [&](double sign) {
+    for (size_t d = 0; d < u.size(); ++d) s->displacement()[d] = u[d] + sign * v[d];
+    return s->strain_energy();
+  };
+  const double a_uv = 0.5 * (energy_of(1.0) - energy_of(-1.0));
+  Field f;
+  s->internal_force(u, f);
+  double fv = 0;
+  for (size_t d = 0; d < u.size(); ++d) fv += f[d] * v[d];
+  EXPECT_NEAR(fv / a_uv, 1.0, 1e-10);
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+  Field f_one, f_two;
+  omp_set_num_threads(1);
+  s->internal_force(u, f_one);
+  omp_set_num_threads(2);
+  s->internal_force(u, f_two);
+  omp_set_num_threads(threads);
+  EXPECT_EQ(f_one, f_two);
+#endif
 }
