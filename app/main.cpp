@@ -19,6 +19,7 @@
 #include "app/virtual_tests.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
+#include "common/interrupt.hpp"
 #include "common/json.hpp"
 
 namespace {
@@ -48,7 +49,8 @@ constexpr const char* usage_run =
     "  --steps N      stop after N steps\n"
     "  --petsc \"...\"  PETSc options for continuum solves, e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
     "  --quiet        no progress line\n"
-    "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed\n";
+    "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed,\n"
+    "  130 / 143 interrupted by Ctrl-C / SIGTERM (outputs so far closed and kept)\n";
 
 constexpr const char* usage_check =
     "usage: arlequin check CASE.yaml [--set key.path=value ...]\n"
@@ -312,6 +314,9 @@ int main(int argc, char** argv) {
   } catch (const RunError& e) {
     std::fprintf(stderr, "arlequin: run stopped: %s\n", e.what());
     return 3;
+  } catch (const Interrupted& e) {
+    std::fprintf(stderr, "arlequin: %s\n", e.what());
+    return 128 + e.signal();  // the shell's convention for a process ended by a signal
   } catch (const std::exception& e) {
     std::fprintf(stderr, "arlequin: internal error: %s\n", e.what());
     return 4;

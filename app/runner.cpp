@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "common/csv_series.hpp"
 #include "common/error.hpp"
 #include "common/fields_writer.hpp"
+#include "common/interrupt.hpp"
 #include "common/json.hpp"
 #include "common/png_plot.hpp"
 
@@ -350,6 +352,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
 
   const auto t_start = Clock::now();
   std::string failure;
+  std::exception_ptr interrupted;  // Ctrl-C or SIGTERM: rethrown once the outputs are closed
+  const InterruptScope interrupt_scope;
   try {
     if (scene.continuum && scene.continuum->is_static() && model.particles.size() == 0) {
       scene.continuum->solve_static();  // a static continuum alone: one solve, one output
@@ -357,6 +361,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     }
     write_outputs();
     for (long n = 1; n <= total_steps; ++n) {
+      if (const int signal = take_interrupt())
+        throw Interrupted(signal, "interrupted by " + signal_name(signal) + " after step " + std::to_string(steps_done) +
+                                      ", t = " + std::to_string(current_time()) + " s; the outputs so far are closed and kept");
       const bool coupled = scene.continuum && scene.continuum->is_coupled();
       if (model.particles.size() > 0 && !coupled) model.step(scene.dt);
       if (scene.continuum) scene.continuum->step(scene.dt);  // both models when coupled
@@ -371,6 +378,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     }
   } catch (const RunError& e) {
     failure = e.what();
+  } catch (const Interrupted& e) {
+    failure = e.what();
+    interrupted = std::current_exception();
   }
   progress.finish();
   outputs.write_plots();
@@ -383,7 +393,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["name"] = scene.name;
   summary["case_file"] = std::filesystem::absolute(scene.case_file).string();
   summary["version"] = ARLEQUIN_VERSION;
-  summary["status"] = failure.empty() ? "completed" : "failed";
+  summary["status"] = failure.empty() ? "completed" : interrupted ? "interrupted" : "failed";
   if (!failure.empty()) summary["error"] = failure;
   if (!result.stop_reason.empty()) summary["stopped_early"] = result.stop_reason;
   summary["steps"] = result.steps;
@@ -433,6 +443,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   sensors = Json::object();
   for (const auto& [name, value] : result.sensors) sensors[name] = value;
   write_json_atomically(scene.output.dir / "summary.json", summary);
+  if (interrupted) std::rethrow_exception(interrupted);
   if (!failure.empty()) throw RunError(failure);
   return result;
 }

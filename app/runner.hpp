@@ -2,7 +2,9 @@
 // summary.json in the output folder, each written atomically), progress and health checks.
 //
 // Contract: on success returns the run's figures; on a RunError (NaN, blow-up) the outputs so
-// far are flushed and closed, summary.json records the failure, and the error is rethrown.
+// far are flushed and closed, summary.json records the failure, and the error is rethrown. A
+// SIGINT or SIGTERM during the time loop ends it the same way, with status "interrupted", and
+// throws Interrupted (common/interrupt.hpp), which no RunError handler catches.
 #pragma once
 #include <algorithm>
 #include <functional>

@@ -1,13 +1,17 @@
 // The cases of cases/ run through the `arlequin` executable, checked against their references.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <csignal>
 #include <fstream>
 #include <limits>
+#include <type_traits>
 
 #include "app/runner.hpp"
 #include "app/scene.hpp"
 #include "app/sweep.hpp"
 #include "common/error.hpp"
+#include "common/interrupt.hpp"
 #include "common/json.hpp"
 #include "support/cli.hpp"
 
@@ -314,6 +318,51 @@ TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
   EXPECT_EQ(s.at("status").as_string(), "failed");
   EXPECT_NE(test::read_text(out / "series.csv").find("time,step"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(out / "fields.xdmf"));
+}
+
+// Ctrl-C during the time loop: the run stops after the step it is in, closes every output as
+// after a failure (series.csv rows, fields.h5 renamed into place, summary.json "interrupted")
+// and throws Interrupted, which is not a RunError, so sweeps and suites do not carry on.
+// Outside the run the signal's previous handler is back.
+TEST(Runner, CtrlCStopsTheRunAndKeepsOutputs) {
+  static_assert(!std::is_base_of_v<RunError, Interrupted>);
+  const auto out = test::scratch_dir("interrupted");
+  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
+  app::RunOptions options;
+  int rows = 0;
+  options.stop_after_row = [&](const auto&) {
+    if (++rows == 3) std::raise(SIGINT);
+    return std::string();
+  };
+  try {
+    app::run_scene(scene, options);
+    FAIL() << "the run should have stopped";
+  } catch (const Interrupted& e) {
+    EXPECT_EQ(e.signal(), SIGINT);
+    EXPECT_NE(std::string(e.what()).find("interrupted by SIGINT"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(rows, 3);
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("status").as_string(), "interrupted");
+  const std::string series = test::read_text(out / "series.csv");
+  EXPECT_EQ(std::count(series.begin(), series.end(), '\n'), 4);  // the header and the three rows
+  EXPECT_TRUE(std::filesystem::exists(out / "fields.h5"));
+  EXPECT_TRUE(no_temporary_files(out));
+  struct sigaction now {};
+  sigaction(SIGINT, nullptr, &now);
+  EXPECT_EQ(now.sa_handler, SIG_DFL);
+}
+
+// The same through the executable, by SIGTERM (a batch system's stop): exit code 128 + 15.
+TEST(Runner, SigtermEndsTheCommandWithItsExitCode) {
+  const auto out = test::scratch_dir("sigterm");
+  // The shell runs arlequin in the background, stops it after a second and reports its code.
+  const auto r = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --set time.end=10 --out " +
+                                    out.string() + " 2>&1 >/dev/null & pid=$!; sleep 1; kill -TERM $pid; wait $pid");
+  EXPECT_EQ(r.exit_code, 128 + SIGTERM) << r.output;
+  EXPECT_NE(r.output.find("interrupted by SIGTERM"), std::string::npos) << r.output;
+  EXPECT_EQ(Json::parse(test::read_text(out / "summary.json")).at("status").as_string(), "interrupted");
+  EXPECT_TRUE(no_temporary_files(out));
 }
 
 }  // namespace
