@@ -356,9 +356,12 @@ TEST(Runner, CtrlCStopsTheRunAndKeepsOutputs) {
 // The same through the executable, by SIGTERM (a batch system's stop): exit code 128 + 15.
 TEST(Runner, SigtermEndsTheCommandWithItsExitCode) {
   const auto out = test::scratch_dir("sigterm");
-  // The shell runs arlequin in the background, stops it after a second and reports its code.
+  // The shell runs arlequin in the background, waits until its fields file is open (the time
+  // loop starts right after), stops it and reports its exit code.
+  const std::string fields_open = "ls " + out.string() + "/fields.h5.part.* >/dev/null 2>&1";
   const auto r = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --set time.end=10 --out " +
-                                    out.string() + " 2>&1 >/dev/null & pid=$!; sleep 1; kill -TERM $pid; wait $pid");
+                                    out.string() + " 2>&1 >/dev/null & pid=$!; for i in $(seq 300); do " + fields_open +
+                                    " && break; sleep 0.1; done; sleep 0.5; kill -TERM $pid; wait $pid");
   EXPECT_EQ(r.exit_code, 128 + SIGTERM) << r.output;
   EXPECT_NE(r.output.find("interrupted by SIGTERM"), std::string::npos) << r.output;
   EXPECT_EQ(Json::parse(test::read_text(out / "summary.json")).at("status").as_string(), "interrupted");
