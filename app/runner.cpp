@@ -354,6 +354,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   std::string failure;
   std::exception_ptr interrupted;  // Ctrl-C or SIGTERM: rethrown once the outputs are closed
   const InterruptScope interrupt_scope;
+  const auto interruption = [&](int signal) {
+    return Interrupted(signal, "interrupted by " + signal_name(signal) + " after step " + std::to_string(steps_done) +
+                                   ", t = " + std::to_string(current_time()) + " s; the outputs so far are closed and kept");
+  };
   try {
     if (scene.continuum && scene.continuum->is_static() && model.particles.size() == 0) {
       scene.continuum->solve_static();  // a static continuum alone: one solve, one output
@@ -361,9 +365,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     }
     write_outputs();
     for (long n = 1; n <= total_steps; ++n) {
-      if (const int signal = take_interrupt())
-        throw Interrupted(signal, "interrupted by " + signal_name(signal) + " after step " + std::to_string(steps_done) +
-                                      ", t = " + std::to_string(current_time()) + " s; the outputs so far are closed and kept");
+      if (const int signal = take_interrupt()) throw interruption(signal);
       const bool coupled = scene.continuum && scene.continuum->is_coupled();
       if (model.particles.size() > 0 && !coupled) model.step(scene.dt);
       if (scene.continuum) scene.continuum->step(scene.dt);  // both models when coupled
@@ -445,6 +447,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   write_json_atomically(scene.output.dir / "summary.json", summary);
   if (interrupted) std::rethrow_exception(interrupted);
   if (!failure.empty()) throw RunError(failure);
+  // A signal after the last step (final outputs, a static solve) leaves this run complete but
+  // still ends the command: a suite must not carry on.
+  if (const int signal = take_interrupt()) throw interruption(signal);
   return result;
 }
 

@@ -4,7 +4,8 @@
 // Contract: on success returns the run's figures; on a RunError (NaN, blow-up) the outputs so
 // far are flushed and closed, summary.json records the failure, and the error is rethrown. A
 // SIGINT or SIGTERM during the time loop ends it the same way, with status "interrupted", and
-// throws Interrupted (common/interrupt.hpp), which no RunError handler catches.
+// throws Interrupted (common/interrupt.hpp), which no RunError handler catches; one that comes
+// after the last step lets the run complete (status "completed") and then throws Interrupted.
 #pragma once
 #include <algorithm>
 #include <functional>

@@ -353,6 +353,25 @@ TEST(Runner, CtrlCStopsTheRunAndKeepsOutputs) {
   EXPECT_EQ(now.sa_handler, SIG_DFL);
 }
 
+// A Ctrl-C after the last step (while the final outputs are written) must not be lost: the run
+// completes, and the command still ends, so a suite does not carry on.
+TEST(Runner, CtrlCAfterTheLastStepStillEndsTheCommand) {
+  const auto out = test::scratch_dir("interrupted_at_end");
+  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
+  app::RunOptions options;
+  options.max_steps = 1;  // rows at steps 0 and 1: the second is the last
+  int rows = 0;
+  options.stop_after_row = [&](const auto&) {
+    if (++rows == 2) std::raise(SIGINT);
+    return std::string();
+  };
+  EXPECT_THROW(app::run_scene(scene, options), Interrupted);
+  EXPECT_EQ(rows, 2);
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_EQ(s.at("status").as_string(), "completed");
+  EXPECT_TRUE(no_temporary_files(out));
+}
+
 // The same through the executable, by SIGTERM (a batch system's stop): exit code 128 + 15.
 TEST(Runner, SigtermEndsTheCommandWithItsExitCode) {
   const auto out = test::scratch_dir("sigterm");
