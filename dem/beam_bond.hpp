@@ -47,7 +47,7 @@ class BeamBondSet final : public BondSet {
   std::string_view law() const override { return "beam"; }
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
   void finalize(std::size_t n_particles) override;
-  void accumulate_forces(ParticleSet& p) const override;
+  void accumulate_forces(ParticleSet& p, const FailureScan& scan) const override;
   double energy(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
@@ -71,6 +71,9 @@ class BeamBondSet final : public BondSet {
  private:
   void zero_stiffness(std::size_t b) override { axial_[b] = bending_[b] = torsion_[b] = 0.0; }
   double energy_of(std::size_t b, const Actions& a) const;
+  // BBF's normal stress terms (above), Pa: N / S, and r_b |M| / I at the more loaded end.
+  double axial_stress(std::size_t b, const Actions& a) const;
+  double bending_stress(std::size_t b, const Actions& a) const;
 
   Parameters parameters_;
   std::vector<double> rest_length_;   // L0, m
@@ -80,6 +83,9 @@ class BeamBondSet final : public BondSet {
   std::vector<double> torsion_;       // G J / L0, N m
   std::vector<Vec3> direction_;       // d0 (reference axis), unit
   std::vector<Vec3> normal_;          // p0 (perpendicular to d0), unit
+  // BBF's sigma per bond from the last force pass with FailureScan::criterion, Pa (scratch
+  // sized by finalize, written by the force loop; one writer per bond).
+  mutable std::vector<double> failure_stress_;
 };
 
 }  // namespace arlequin::dem

@@ -4,7 +4,9 @@
 // reference; both DEs must still have their reference (identity) orientation, because laws
 // store reference directions once per bond instead of once per end. finalize() is called
 // once after the last add() and before the first force evaluation. accumulate_forces() adds
-// (never overwrites) forces and torques: one virtual call per batch, none per bond.
+// (never overwrites) forces and torques: one virtual call per batch, none per bond. With a
+// FailureScan it also records, from the same per-bond kinematics, what the failure check of
+// that configuration needs, so a breakable step evaluates each bond once, not twice.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -71,13 +73,21 @@ inline void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t
   add_symmetric_product(virial[j], (2.0 - share_i) * r, f_i);
 }
 
+// What a force pass records besides forces, for the failure check of the same configuration
+// (DemModel::apply_failures).
+struct FailureScan {
+  bool criterion = false;  // each bond's failure measure, read by find_failures()
+  std::span<Sym3> virial;  // if not empty: every intact bond's virial added, as accumulate_virial()
+  VirialBranch branch = VirialBranch::half;
+};
+
 class BondSet {
  public:
   virtual ~BondSet() = default;
   virtual std::string_view law() const = 0;
   virtual void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) = 0;
   virtual void finalize(std::size_t n_particles) = 0;
-  virtual void accumulate_forces(ParticleSet& p) const = 0;
+  virtual void accumulate_forces(ParticleSet& p, const FailureScan& scan) const = 0;
   // Elastic energy stored in the batch, J.
   virtual double energy(const ParticleSet& p) const = 0;
   // Adds to every DE's row the block-Gershgorin bound of omega^2 (rad^2/s^2) coming from this
@@ -90,8 +100,10 @@ class BondSet {
   virtual void scale_stiffness(std::span<const double> factor) = 0;
 
   // Failure. has_strength(): the law was given a strength, so find_failures() can report
-  // events (BBF for beams, maximum elongation for springs). accumulate_virial() adds every
-  // intact bond's sym(b (x) f) to both its DEs (RDEF, see failure.hpp; add_bond_virial).
+  // events (BBF for beams, maximum elongation for springs) for the configuration of the last
+  // accumulate_forces() with scan.criterion (the measures it recorded). accumulate_virial()
+  // adds every intact bond's sym(b (x) f) to both its DEs (RDEF, see failure.hpp;
+  // add_bond_virial).
   virtual bool has_strength() const = 0;
   virtual void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
                              std::vector<BreakEvent>& events) const = 0;

@@ -160,7 +160,8 @@ void DemModel::advance_to_forces(double dt) {
   drift(dt);                          // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
   time_ += dt;
   update_neighbours();                // only with contact, only when a DE moved > skin/2
-  compute_forces();                   // bonds, contacts -> f(n+1)
+  // Bonds, contacts -> f(n+1); breakable: also each bond's failure measure or virial.
+  compute_forces(failure_on_ ? failure_scan() : FailureScan{});
   if (failure_on_) apply_failures();  // BBF / RDEF: break bonds, forces again if any broke
   record_reactions();                 // for sensors, and the work of driven DEs
   apply_loads_and_damping();          // dead loads, viscous damping
@@ -241,10 +242,21 @@ void DemModel::update_neighbours() {
   if (neighbours_ && neighbours_->needs_rebuild(particles)) neighbours_->build(particles);
 }
 
-void DemModel::compute_forces() {
+void DemModel::compute_forces(const FailureScan& scan) {
   particles.clear_forces();
-  for (const auto& set : bond_sets_) set->accumulate_forces(particles);
+  for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
   if (contact_) contact_->accumulate_forces(*neighbours_, particles);
+}
+
+FailureScan DemModel::failure_scan() {
+  FailureScan scan;
+  scan.criterion = true;
+  if (rdef_) {
+    rdef_stress_.assign(particles.size(), Sym3{});
+    scan.virial = rdef_stress_;
+    scan.branch = rdef_->volume == RdefVolume::laguerre ? VirialBranch::radical : VirialBranch::half;
+  }
+  return scan;
 }
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> DemModel::intact_bonded_pairs() const {
@@ -261,13 +273,11 @@ void DemModel::apply_failures() {
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) {
     const ParticleSet& p = particles;
-    virial_stress(rdef_omega_, rdef_->volume == RdefVolume::laguerre ? VirialBranch::radical : VirialBranch::half, rdef_stress_);
+    divide_by_volumes(rdef_omega_, rdef_stress_);  // the virial of the step's force pass
     if (rdef_->average == RdefAverage::bonded_neighbours) average_over_bonded_neighbours(rdef_stress_);
     rdef_equivalent_.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double equivalent = equivalent_stress(rdef_stress_[i], rdef_->equivalent);
-      rdef_equivalent_[i] = equivalent >= rdef_threshold_[i] ? equivalent : -1.0;  // -1: the DE holds
-    }
+    for (std::size_t i = 0; i < p.size(); ++i)  // -1: the DE holds
+      rdef_equivalent_[i] = equivalent_stress_reaching(rdef_stress_[i], rdef_->equivalent, rdef_threshold_[i]);
     for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
       const BondSet& set = *bond_sets_[s];
       for (std::size_t b = 0; b < set.size(); ++b) {
@@ -340,8 +350,12 @@ void DemModel::virial_stress(const std::vector<double>& omega, VirialBranch bran
   // branch (half), or the branch to the radical plane (bond_set.hpp).
   sigma.assign(particles.size(), Sym3{});
   for (const auto& set : bond_sets_) set->accumulate_virial(particles, branch, sigma);
-  for (std::size_t i = 0; i < particles.size(); ++i)
-    for (double& c : sigma[i]) c /= 2.0 * omega[i];
+  divide_by_volumes(omega, sigma);
+}
+
+void DemModel::divide_by_volumes(const std::vector<double>& omega, std::vector<Sym3>& virial) {
+  for (std::size_t i = 0; i < virial.size(); ++i)
+    for (double& c : virial[i]) c /= 2.0 * omega[i];
 }
 
 std::vector<double> DemModel::damage() const {

@@ -128,13 +128,18 @@ class DemModel {
   void impose_motion(double t, bool half_step, double dt);
   void drift(double dt);
   void update_neighbours();
-  void compute_forces();
+  void compute_forces(const FailureScan& scan = {});
+  // The scan that records, in the step's force pass, what apply_failures() needs (zeroes the
+  // RDEF virial it accumulates into).
+  FailureScan failure_scan();
   void record_reactions();
   void apply_failures();
   void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
   // Virial stress of every DE with the volume shares omega (m^3) and the bonds' branch vectors
   // to `branch`, into sigma (resized).
   void virial_stress(const std::vector<double>& omega, VirialBranch branch, std::vector<Sym3>& sigma) const;
+  // sigma_i = virial_i / (2 Omega_i) (seed Eq. 1), in place.
+  static void divide_by_volumes(const std::vector<double>& omega, std::vector<Sym3>& virial);
   std::vector<double> sphere_volume_shares(double compaction) const;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;
@@ -159,7 +164,7 @@ class DemModel {
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
-  std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial stress per DE
+  std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial per DE (force pass), then stress
   std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
   std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega
   std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (m^3)

@@ -6,13 +6,25 @@
 
 namespace arlequin::dem {
 
-double max_principal(const Sym3& t) {
-  // Eigenvalues of a symmetric 3x3 matrix: Smith's trigonometric form (CACM 4 (1961) 168).
-  const double p1 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5];
+namespace {
+
+// Smith's trigonometric form of a symmetric 3x3 matrix's eigenvalues (CACM 4 (1961) 168):
+// q + 2 p cos(phi + 2 pi k / 3), q the mean of the diagonal, p the deviator's scale.
+struct SmithScale {
+  double q, p;
+};
+SmithScale smith_scale(const Sym3& t, double p1) {
   const double q = (t[0] + t[1] + t[2]) / 3.0;
-  if (p1 == 0.0) return std::max({t[0], t[1], t[2]});
   const double p2 = (t[0] - q) * (t[0] - q) + (t[1] - q) * (t[1] - q) + (t[2] - q) * (t[2] - q) + 2.0 * p1;
-  const double p = std::sqrt(p2 / 6.0);
+  return {q, std::sqrt(p2 / 6.0)};
+}
+
+}  // namespace
+
+double max_principal(const Sym3& t) {
+  const double p1 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5];
+  if (p1 == 0.0) return std::max({t[0], t[1], t[2]});
+  const auto [q, p] = smith_scale(t, p1);
   // B = (A - q I) / p; r = det(B) / 2, clamped to [-1, 1] against round-off.
   const double b0 = (t[0] - q) / p, b1 = (t[1] - q) / p, b2 = (t[2] - q) / p;
   const double b3 = t[3] / p, b4 = t[4] / p, b5 = t[5] / p;
@@ -27,6 +39,20 @@ double von_mises(const Sym3& t) {
 }
 
 double hydrostatic(const Sym3& t) { return (t[0] + t[1] + t[2]) / 3.0; }
+
+double equivalent_stress_reaching(const Sym3& t, RdefEquivalent kind, double threshold) {
+  if (kind == RdefEquivalent::max_principal) {
+    // max_principal returns q + 2 p c with c = cos(...) <= 1, so q + 2 p bounds it in floating
+    // point too (same q and p).
+    const double p1 = t[3] * t[3] + t[4] * t[4] + t[5] * t[5];
+    if (p1 != 0.0) {
+      const auto [q, p] = smith_scale(t, p1);
+      if (q + 2.0 * p < threshold) return -1.0;
+    }
+  }
+  const double equivalent = equivalent_stress(t, kind);
+  return equivalent >= threshold ? equivalent : -1.0;
+}
 
 double equivalent_stress(const Sym3& t, RdefEquivalent kind) {
   switch (kind) {

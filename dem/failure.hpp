@@ -51,6 +51,10 @@ double hydrostatic(const Sym3& t);  // trace / 3 (tension positive)
 // The equivalent stress an RDEF threshold is compared with.
 enum class RdefEquivalent : std::uint8_t { max_principal, von_mises, hydrostatic };
 double equivalent_stress(const Sym3& t, RdefEquivalent kind);
+// equivalent_stress(t, kind) if it reaches `threshold`, else -1. For max_principal a cheap upper
+// bound (the mean plus twice Smith's scale, without the trigonometry) settles most DEs; the
+// decision is the same as equivalent_stress's to the last bit.
+double equivalent_stress_reaching(const Sym3& t, RdefEquivalent kind, double threshold);
 enum class RdefAverage : std::uint8_t { none, bonded_neighbours };
 // The DE's volume share Omega_i: its sphere volume / compaction, or its Laguerre cell
 // (laguerre_cells.hpp) in the sample's box.

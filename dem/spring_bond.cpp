@@ -25,6 +25,11 @@ void SpringBondSet::finalize(std::size_t n_particles) {
   const auto order = order_pairs(n_particles);
   apply_order(rest_length_, order);
   apply_order(stiffness_, order);
+  elongation_.assign(size(), 0.0);
+}
+
+double SpringBondSet::elongation(std::size_t b, const ParticleSet& p) const {
+  return norm(p.position[second_[b]] - p.position[first_[b]]) / rest_length_[b] - 1.0;
 }
 
 Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const {
@@ -33,11 +38,21 @@ Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const {
   return d * (-stiffness_[b] * (L - rest_length_[b]) / L);
 }
 
-void SpringBondSet::accumulate_forces(ParticleSet& p) const {
-  for_each_bond(colouring_, [&](std::size_t b) {
-    const Vec3 f_j = force_on_j(b, p);
+void SpringBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) const {
+  const auto add_force = [&p, this](std::size_t b, const Vec3& f_j) {
     p.force[first_[b]] -= f_j;
     p.force[second_[b]] += f_j;
+  };
+  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty();
+  if (!criterion && !virial) {  // the plain pass: no test per bond (as BeamBondSet)
+    for_each_bond(colouring_, [&](std::size_t b) { add_force(b, force_on_j(b, p)); });
+    return;
+  }
+  for_each_bond(colouring_, [&](std::size_t b) {
+    const Vec3 f_j = force_on_j(b, p);
+    add_force(b, f_j);
+    if (criterion) elongation_[b] = elongation(b, p);
+    if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -f_j, scan.branch, scan.virial);
   });
 }
 
@@ -57,10 +72,9 @@ void SpringBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index,
   if (!has_strength()) return;
   for (std::size_t b = 0; b < size(); ++b) {
     if (broken_[b]) continue;
-    const double elongation = norm(p.position[second_[b]] - p.position[first_[b]]) / rest_length_[b] - 1.0;
-    if (elongation >= max_elongation_)
+    if (elongation_[b] >= max_elongation_)
       events.push_back({time, set_index, static_cast<std::uint32_t>(b), FailureCriterion::elongation,
-                        FailureMode::tension, elongation, bond_energy(b, p)});
+                        FailureMode::tension, elongation_[b], bond_energy(b, p)});
   }
 }
 

@@ -21,7 +21,7 @@ class SpringBondSet final : public BondSet {
   std::string_view law() const override { return "spring"; }
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
   void finalize(std::size_t n_particles) override;
-  void accumulate_forces(ParticleSet& p) const override;
+  void accumulate_forces(ParticleSet& p, const FailureScan& scan) const override;
   double energy(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
@@ -40,6 +40,10 @@ class SpringBondSet final : public BondSet {
   double max_elongation_;            // 0 = unbreakable
   std::vector<double> stiffness_;    // K per bond (weighted), N/m
   std::vector<double> rest_length_;  // L0, m
+  // Elongation per bond from the last force pass with FailureScan::criterion (scratch sized
+  // by finalize; one writer per bond).
+  mutable std::vector<double> elongation_;
+  double elongation(std::size_t b, const ParticleSet& p) const;  // L / L0 - 1
 };
 
 }  // namespace arlequin::dem

@@ -150,7 +150,7 @@ TEST(SpringBond, ForceAndEnergyClosedForm) {
   spring.finalize(2);
   p.position[1] = {1.3, 1.4, 0.0};
   p.clear_forces();
-  spring.accumulate_forces(p);
+  spring.accumulate_forces(p, {});
   const double L = std::hypot(1.3, 1.4), L0 = std::sqrt(2.0);
   expect_relative(norm(p.force[1]), 250.0 * (L - L0));
   expect_relative(dot(p.force[1], Vec3{1.3, 1.4, 0} / L), -250.0 * (L - L0));

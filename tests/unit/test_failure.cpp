@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 
 #include "dem/penalty_contact.hpp"
 #include "dem/spring_bond.hpp"
@@ -12,6 +13,13 @@
 
 namespace arlequin::dem {
 namespace {
+
+// A force pass that records the failure measures, as a breakable step's does.
+FailureScan criterion_scan() {
+  FailureScan scan;
+  scan.criterion = true;
+  return scan;
+}
 
 using test::R1Beam;
 
@@ -25,7 +33,10 @@ struct BreakablePair : ::testing::Test {
     beam.add(0, 1, p);
     beam.finalize(2);
   }
-  std::vector<BreakEvent> failures() const {
+  // The check reads the measures of the last force pass with a failure scan, as in a step.
+  std::vector<BreakEvent> failures() {
+    p.clear_forces();
+    beam.accumulate_forces(p, criterion_scan());
     std::vector<BreakEvent> events;
     beam.find_failures(p, 0, 0.0, events);
     return events;
@@ -62,7 +73,7 @@ TEST_F(BreakablePair, ABrokenBondCarriesNoForce) {
   p.orientation[0] = from_rotation_vector({0.01, 0.0, 0.02});
   beam.break_bond(0);
   p.clear_forces();
-  beam.accumulate_forces(p);
+  beam.accumulate_forces(p, {});
   EXPECT_EQ(norm(p.force[0]) + norm(p.force[1]) + norm(p.torque[0]) + norm(p.torque[1]), 0.0);
   EXPECT_EQ(beam.energy(p), 0.0);
   EXPECT_TRUE(failures().empty());  // broken once, never reported again
@@ -77,9 +88,11 @@ TEST(SpringFailure, BreaksAtTheMaximumElongation) {
   spring.finalize(2);
   std::vector<BreakEvent> events;
   p.position[1].x = 2.0 * (1.05 - 1e-9);
+  spring.accumulate_forces(p, criterion_scan());
   spring.find_failures(p, 0, 0.0, events);
   EXPECT_TRUE(events.empty());
   p.position[1].x = 2.0 * (1.05 + 1e-9);
+  spring.accumulate_forces(p, criterion_scan());
   spring.find_failures(p, 0, 0.0, events);
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].criterion, FailureCriterion::elongation);
@@ -111,6 +124,28 @@ TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
 // lattice cube a^3 = sphere volume / (pi/6), so RDEF breaks exactly what it breaks with the
 // sphere share at compaction pi/6: just under the applied stress, the DEs with both x-bonds;
 // just over it, nothing.
+// The threshold test of RDEF decides as equivalent_stress does, bit for bit, with or without
+// the shortcut (random tensors, thresholds at, just above and just below the value).
+TEST(Rdef, ThresholdTestMatchesTheEquivalentStressExactly) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  int shortcut_cases = 0;
+  for (int n = 0; n < 20000; ++n) {
+    Sym3 t;
+    for (double& c : t) c = uni(rng);
+    if (n % 4 == 0) t[3] = t[4] = t[5] = 0.0;  // diagonal: the other branch
+    for (auto kind : {RdefEquivalent::max_principal, RdefEquivalent::von_mises, RdefEquivalent::hydrostatic}) {
+      const double e = equivalent_stress(t, kind);
+      for (double threshold : {e, std::nextafter(e, 2.0), std::nextafter(e, -2.0), e + 0.5, e - 0.5}) {
+        const double expected = e >= threshold ? e : -1.0;
+        ASSERT_EQ(equivalent_stress_reaching(t, kind, threshold), expected) << n;
+        shortcut_cases += kind == RdefEquivalent::max_principal && expected < 0.0;
+      }
+    }
+  }
+  EXPECT_GT(shortcut_cases, 1000);
+}
+
 TEST(Rdef, LaguerreSharesInACubicLatticeAreTheLatticeCube) {
   const double R = 1e-3, a = 2 * R, eps = 1e-4, E = 2e11;
   const double applied = E * std::numbers::pi * 0.25 * R * R * eps / (a * a);
