@@ -50,7 +50,7 @@ template <class Body>
 void for_each_bond(const BondColouring& colouring, Body&& body) {
   for (std::size_t c = 0; c + 1 < colouring.offsets.size(); ++c) {
     const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
-#pragma omp parallel for schedule(static) if (end - begin > parallel_threshold)
+#pragma omp parallel for schedule(static) if (end - begin > parallel_threshold_bonds)
     for (long b = begin; b < end; ++b) body(static_cast<std::size_t>(b));
   }
 }

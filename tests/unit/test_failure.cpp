@@ -7,6 +7,10 @@
 #include <memory>
 #include <random>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "dem/penalty_contact.hpp"
 #include "dem/spring_bond.hpp"
 #include "support/dem_fixtures.hpp"
@@ -145,6 +149,63 @@ TEST(Rdef, ThresholdTestMatchesTheEquivalentStressExactly) {
   }
   EXPECT_GT(shortcut_cases, 1000);
 }
+
+#ifdef _OPENMP
+// The force pass with a failure scan runs a colour's bonds on threads (above
+// parallel_threshold_bonds): forces, torques, BBF measures and virials are the same to the bit
+// on 1 and 2 threads, and so are the failures found.
+TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
+  DemModel model;
+  const double R = 1e-3, a = 2 * R;
+  build_lattice(model.particles, {0, 0, 0}, {12, 12, 12}, a, R, 7800.0);
+  BeamBondSet& beam = test::bond_all_touching(model, {2e11, 0.3, 0.5, 1.0e9});
+  model.finalize();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  ParticleSet& p = model.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.position[i] += Vec3{uni(rng), uni(rng), uni(rng)} * (2e-3 * a);
+    p.orientation[i] = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 2e-3);
+  }
+  struct Pass {
+    std::vector<Vec3> force, torque;
+    std::vector<Sym3> virial;
+    std::vector<BreakEvent> events;
+  };
+  const auto pass = [&](int threads) {
+    const int before = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    Pass out;
+    out.virial.assign(p.size(), Sym3{});
+    FailureScan scan = criterion_scan();
+    scan.virial = out.virial;
+    p.clear_forces();
+    beam.accumulate_forces(p, scan);
+    beam.find_failures(p, 0, 0.0, out.events);
+    omp_set_num_threads(before);
+    out.force = p.force;
+    out.torque = p.torque;
+    return out;
+  };
+  const Pass one = pass(1), two = pass(2);
+  EXPECT_GT(beam.size() / 6, std::size_t(parallel_threshold_bonds));  // colours large enough to go parallel
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_EQ(one.force[i], two.force[i]) << i;
+    ASSERT_EQ(one.torque[i], two.torque[i]) << i;
+    ASSERT_EQ(one.virial[i], two.virial[i]) << i;
+  }
+  ASSERT_FALSE(one.events.empty());  // the perturbation overloads some bonds
+  ASSERT_EQ(one.events.size(), two.events.size());
+  for (std::size_t k = 0; k < one.events.size(); ++k) {
+    EXPECT_EQ(one.events[k].bond, two.events[k].bond);
+    EXPECT_EQ(one.events[k].stress, two.events[k].stress);
+  }
+  // The virial of the force pass is accumulate_virial's.
+  std::vector<Sym3> reference(p.size(), Sym3{});
+  beam.accumulate_virial(p, VirialBranch::half, reference);
+  for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(reference[i], one.virial[i]) << i;
+}
+#endif
 
 TEST(Rdef, LaguerreSharesInACubicLatticeAreTheLatticeCube) {
   const double R = 1e-3, a = 2 * R, eps = 1e-4, E = 2e11;
