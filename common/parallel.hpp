@@ -4,7 +4,8 @@
 
 namespace arlequin {
 
-// Loops shorter than this run on one thread: below it, starting threads costs more than it saves.
+// Loops of at most this many items run on one thread: below it, starting threads costs more
+// than it saves.
 inline constexpr long parallel_threshold = 4096;
 // The same for loops over bonds (one colour of a bond set), whose items cost 10-100 times a
 // DE's update: a random packing's bond sets colour into ~20 colours of a few hundred to a few

@@ -166,6 +166,7 @@ double BeamBondSet::energy(const ParticleSet& p) const {
 void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
                                 std::vector<BreakEvent>& events) const {
   if (!has_strength()) return;
+  if (failure_stress_.size() != size()) throw std::logic_error("BeamBondSet::find_failures: bonds added after finalize()");
   const double E = parameters_.young, G = E / (2.0 * (1.0 + parameters_.poisson));
   for (std::size_t b = 0; b < size(); ++b) {
     if (broken_[b] || failure_stress_[b] < parameters_.strength) continue;

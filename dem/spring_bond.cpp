@@ -1,6 +1,7 @@
 #include "dem/spring_bond.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "common/case_file.hpp"
 
@@ -70,6 +71,7 @@ double SpringBondSet::energy(const ParticleSet& p) const {
 void SpringBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
                                   std::vector<BreakEvent>& events) const {
   if (!has_strength()) return;
+  if (elongation_.size() != size()) throw std::logic_error("SpringBondSet::find_failures: bonds added after finalize()");
   for (std::size_t b = 0; b < size(); ++b) {
     if (broken_[b]) continue;
     if (elongation_[b] >= max_elongation_)
