@@ -157,10 +157,8 @@ double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
 double BeamBondSet::bond_energy(std::size_t b, const ParticleSet& p) const { return energy_of(b, actions(b, p)); }
 
 double BeamBondSet::energy(const ParticleSet& p) const {
-  double e = 0.0;
-#pragma omp parallel for reduction(+ : e) schedule(static) if (size() > parallel_threshold)
-  for (long bl = 0; bl < static_cast<long>(size()); ++bl) e += bond_energy(static_cast<std::size_t>(bl), p);
-  return e;
+  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, energy_partial_,
+                         [&](long b) { return bond_energy(static_cast<std::size_t>(b), p); });
 }
 
 void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,

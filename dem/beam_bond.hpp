@@ -86,6 +86,7 @@ class BeamBondSet final : public BondSet {
   // BBF's sigma per bond from the last force pass with FailureScan::criterion, Pa (scratch
   // sized by finalize, written by the force loop; one writer per bond).
   mutable std::vector<double> failure_stress_;
+  mutable std::vector<double> energy_partial_;  // energy()'s chunk sums (fixed_order_sum)
 };
 
 }  // namespace arlequin::dem

@@ -191,18 +191,15 @@ void DemModel::kick(double half_dt) {
   const long n = static_cast<long>(p.size());
   // A half kick changes a DE's kinetic energy by h F . (v + v')/2 exactly; the damping
   // force's share of that is the energy it dissipated.
-  double damped = 0.0;
   const bool damping = damping_ > 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : damped) if (n > parallel_threshold)
-  for (long i = 0; i < n; ++i) {
+  dissipated_ += fixed_order_sum(n, parallel_threshold, kick_partial_, [&](long i) {
     const Vec3 v = p.velocity[i], w = p.angular_velocity[i];
     p.velocity[i] += p.force[i] * (half_dt * p.inv_mass[i]);
     p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia(i));
-    if (damping)
-      damped -= half_dt * (dot(damping_force_[i], 0.5 * (v + p.velocity[i])) +
-                           dot(damping_torque_[i], 0.5 * (w + p.angular_velocity[i])));
-  }
-  dissipated_ += damped;
+    return damping ? -half_dt * (dot(damping_force_[i], 0.5 * (v + p.velocity[i])) +
+                                 dot(damping_torque_[i], 0.5 * (w + p.angular_velocity[i])))
+                   : 0.0;
+  });
 }
 
 void DemModel::impose_motion(double t, bool half_step, double dt) {

@@ -164,6 +164,7 @@ class DemModel {
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
+  std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
   std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial per DE (force pass), then stress
   std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
   std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega

@@ -220,21 +220,22 @@ TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(reference[i], one.virial[i]) << i;
 }
 
-// Whole steps of a breakable model on 1 and 2 threads: beams with BBF, springs with a maximum
-// elongation on the same pairs, and RDEF on Laguerre cells (radical branch), started from
-// random velocities that break bonds by every criterion within the run. Same breaks, same
-// positions, to the bit.
+// Whole steps of a damped breakable model on 1 and 2 threads: beams with BBF, springs with a
+// maximum elongation on the same pairs, and RDEF on Laguerre cells (radical branch), started
+// from random velocities that break bonds by every criterion within the run. Same breaks, same
+// positions and the same energies (bond, damping work), to the bit.
 TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
   struct Run {
     std::vector<Vec3> position;
     std::vector<BreakEvent> breaks;
+    Energies energies;
   };
   const auto run = [](int threads) {
     const int before = omp_get_max_threads();
     omp_set_num_threads(threads);
     DemModel model;
     const double R = 1e-3, a = 2 * R;
-    build_lattice(model.particles, {0, 0, 0}, {16, 16, 16}, a, R, 7800.0);
+    build_lattice(model.particles, {0, 0, 0}, {17, 16, 16}, a, R, 7800.0);  // above parallel_threshold DEs
     test::bond_all_touching(model, {2e11, 0.3, 0.5, 2.5e8});
     auto springs = std::make_unique<SpringBondSet>(1e6, 4e-4);
     for (auto [i, j] : close_pairs(model.particles, 0.01)) springs->add(i, j, model.particles);
@@ -243,6 +244,7 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     rdef.threshold = 1.0e7;
     rdef.volume = RdefVolume::laguerre;
     model.enable_rdef(rdef);
+    model.set_damping(0.05);
     model.finalize();
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> uni(-1.0, 1.0);
@@ -250,7 +252,7 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     const double dt = 0.5 * model.critical_time_step();
     for (int n = 0; n < 40; ++n) model.step(dt);
     omp_set_num_threads(before);
-    return Run{model.particles.position, model.breaks()};
+    return Run{model.particles.position, model.breaks(), model.energies()};
   };
   const Run one = run(1), two = run(2);
   std::array<int, 3> by_criterion{};
@@ -265,6 +267,11 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     EXPECT_EQ(one.breaks[k].time, two.breaks[k].time);
   }
   for (std::size_t i = 0; i < one.position.size(); ++i) ASSERT_EQ(one.position[i], two.position[i]) << i;
+  EXPECT_GT(one.energies.dissipated, 0.0);
+  EXPECT_EQ(one.energies.bond, two.energies.bond);
+  EXPECT_EQ(one.energies.dissipated, two.energies.dissipated);
+  EXPECT_EQ(one.energies.kinetic, two.energies.kinetic);
+  EXPECT_EQ(one.energies.fracture, two.energies.fracture);
 }
 #endif
 
