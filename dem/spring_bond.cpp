@@ -29,15 +29,16 @@ void SpringBondSet::finalize(std::size_t n_particles) {
   elongation_.assign(size(), 0.0);
 }
 
-double SpringBondSet::elongation(std::size_t b, const ParticleSet& p) const {
-  return norm(p.position[second_[b]] - p.position[first_[b]]) / rest_length_[b] - 1.0;
+SpringBondSet::Stretch SpringBondSet::stretch(std::size_t b, const ParticleSet& p) const {
+  const Vec3 d = p.position[second_[b]] - p.position[first_[b]];
+  return {d, norm(d)};
 }
 
-Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const {
-  const Vec3 d = p.position[second_[b]] - p.position[first_[b]];
-  const double L = norm(d);
-  return d * (-stiffness_[b] * (L - rest_length_[b]) / L);
+Vec3 SpringBondSet::force_on_j(std::size_t b, const Stretch& s) const {
+  return s.d * (-stiffness_[b] * (s.length - rest_length_[b]) / s.length);
 }
+
+Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const { return force_on_j(b, stretch(b, p)); }
 
 void SpringBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) const {
   const auto add_force = [&p, this](std::size_t b, const Vec3& f_j) {
@@ -50,9 +51,10 @@ void SpringBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) c
     return;
   }
   for_each_bond(colouring_, [&](std::size_t b) {
-    const Vec3 f_j = force_on_j(b, p);
+    const Stretch s = stretch(b, p);
+    const Vec3 f_j = force_on_j(b, s);
     add_force(b, f_j);
-    if (criterion) elongation_[b] = elongation(b, p);
+    if (criterion) elongation_[b] = s.length / rest_length_[b] - 1.0;
     if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -f_j, scan.branch, scan.virial);
   });
 }

@@ -34,6 +34,14 @@ class SpringBondSet final : public BondSet {
 
  private:
   void zero_stiffness(std::size_t b) override { stiffness_[b] = 0.0; }
+  // d = x_j - x_i and its length L: the force -K (L - L0) d / L and the elongation L / L0 - 1
+  // both follow from one evaluation.
+  struct Stretch {
+    Vec3 d;
+    double length;
+  };
+  Stretch stretch(std::size_t b, const ParticleSet& p) const;
+  Vec3 force_on_j(std::size_t b, const Stretch& s) const;
   Vec3 force_on_j(std::size_t b, const ParticleSet& p) const;
 
   double nominal_stiffness_;         // K of the case file, N/m
@@ -43,7 +51,6 @@ class SpringBondSet final : public BondSet {
   // Elongation per bond from the last force pass with FailureScan::criterion (scratch sized
   // by finalize; one writer per bond).
   mutable std::vector<double> elongation_;
-  double elongation(std::size_t b, const ParticleSet& p) const;  // L / L0 - 1
 };
 
 }  // namespace arlequin::dem
