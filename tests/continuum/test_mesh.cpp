@@ -1,12 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "common/error.hpp"
 #include "continuum/mesh.hpp"
+#include "support/omp_threads.hpp"
 #include "continuum_test_util.hpp"
 
 using namespace arlequin;
@@ -29,11 +27,9 @@ TEST(ContinuumMesh, GeoIsMeshedWithNamedGroups) {
 // load must leave the OpenMP thread count as it found it, or every later parallel loop of the
 // scene (DEM bonds, continuum forces) runs on one thread.
 TEST(ContinuumMesh, LoadingAMeshKeepsTheOpenMpThreadCount) {
-  const int before = omp_get_max_threads();
-  omp_set_num_threads(3);
+  const test::OmpThreads three(3);
   Mesh::load({mesh_path("unit_cube.geo"), 0.5, 1, {}});
   EXPECT_EQ(omp_get_max_threads(), 3);
-  omp_set_num_threads(before);
 }
 #endif
 

@@ -1,12 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <random>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "continuum/nem/nem_solver.hpp"
 #include "convergence_util.hpp"
+#include "support/omp_threads.hpp"
 
 using namespace arlequin;
 using namespace arlequin::continuum;
@@ -187,13 +185,15 @@ TEST(ContinuumNem, InternalForceIsTheBilinearFormOnAnyThreadCount) {
   for (size_t d = 0; d < u.size(); ++d) fv += f[d] * v[d];
   EXPECT_NEAR(fv / a_uv, 1.0, 1e-10);
 #ifdef _OPENMP
-  const int threads = omp_get_max_threads();
   Field f_one, f_two;
-  omp_set_num_threads(1);
-  s->internal_force(u, f_one);
-  omp_set_num_threads(2);
-  s->internal_force(u, f_two);
-  omp_set_num_threads(threads);
+  {
+    const test::OmpThreads one(1);
+    s->internal_force(u, f_one);
+  }
+  {
+    const test::OmpThreads two(2);
+    s->internal_force(u, f_two);
+  }
   EXPECT_EQ(f_one, f_two);
 #endif
 }

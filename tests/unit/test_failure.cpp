@@ -9,13 +9,10 @@
 #include <memory>
 #include <random>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "dem/penalty_contact.hpp"
 #include "dem/spring_bond.hpp"
 #include "support/dem_fixtures.hpp"
+#include "support/omp_threads.hpp"
 
 namespace arlequin::dem {
 namespace {
@@ -185,8 +182,7 @@ TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
     std::vector<BreakEvent> events;
   };
   const auto pass = [&](int threads) {
-    const int before = omp_get_max_threads();
-    omp_set_num_threads(threads);
+    const test::OmpThreads scope(threads);
     Pass out;
     out.virial.assign(p.size(), Sym3{});
     FailureScan scan = criterion_scan();
@@ -194,7 +190,6 @@ TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
     p.clear_forces();
     beam.accumulate_forces(p, scan);
     beam.find_failures(p, 0, 0.0, out.events);
-    omp_set_num_threads(before);
     out.force = p.force;
     out.torque = p.torque;
     return out;
@@ -231,8 +226,7 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     Energies energies;
   };
   const auto run = [](int threads) {
-    const int before = omp_get_max_threads();
-    omp_set_num_threads(threads);
+    const test::OmpThreads scope(threads);
     DemModel model;
     const double R = 1e-3, a = 2 * R;
     build_lattice(model.particles, {0, 0, 0}, {17, 16, 16}, a, R, 7800.0);  // above parallel_threshold DEs
@@ -251,7 +245,6 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     for (auto& v : model.particles.velocity) v = Vec3{uni(rng), uni(rng), uni(rng)} * 2.0;  // m/s
     const double dt = 0.5 * model.critical_time_step();
     for (int n = 0; n < 40; ++n) model.step(dt);
-    omp_set_num_threads(before);
     return Run{model.particles.position, model.breaks(), model.energies()};
   };
   const Run one = run(1), two = run(2);
