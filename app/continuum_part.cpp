@@ -92,7 +92,7 @@ class Part final : public ContinuumPart {
     solver_->set_initial_displacement(u);
   }
   std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
-  double coupling_work() const override { return coupled_ ? coupled_->energies().coupling_work : 0.0; }
+  double coupling_work() const override { return coupled_ ? coupled_->coupling_work() : 0.0; }
 
   bool in_dem_domain(const Vec3& x) const override { return !zone_ || zone_->in_dem_domain(x); }
   void couple(dem::DemModel& dem) override {

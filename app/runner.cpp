@@ -335,6 +335,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const double slack = 1e-6 * scene.dt;
   long steps_done = 0;
   const auto current_time = [&] { return steps_done * scene.dt; };
+  // Outputs are written after step n when it ends on a row or a frame, or is the last.
+  const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
   const auto write_outputs = [&] {
     const auto t0 = Clock::now();
     result.energies = model.energies();
@@ -367,14 +369,15 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     for (long n = 1; n <= total_steps; ++n) {
       if (const int signal = take_interrupt()) throw interruption(signal);
       const bool coupled = scene.continuum && scene.continuum->is_coupled();
+      if (output_after(n)) model.record_energies_in_next_step();  // the step's force pass gives the row's bond energies
       if (model.particles.size() > 0 && !coupled) model.step(scene.dt);
       if (scene.continuum) scene.continuum->step(scene.dt);  // both models when coupled
       ++steps_done;
-      if (n == 1) energy_scale = std::max(energy_scale, model.energies().kinetic);
+      if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
       model.check_finite();
       if (n % 50 == 0 || n == total_steps)
         model.check_energy(100.0 * (energy_scale + std::abs(model.external_work())) + 1e-300);
-      if (current_time() + slack >= std::min(next_row, next_frame) || n == total_steps) write_outputs();
+      if (output_after(n)) write_outputs();
       progress.update(n, current_time());
       if (!result.stop_reason.empty()) break;
     }

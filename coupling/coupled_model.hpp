@@ -109,6 +109,7 @@ class CoupledModel {
   long steps_done() const { return steps_; }
 
   CoupledEnergies energies() const;
+  double coupling_work() const { return coupling_work_; }  // J, as in energies(), without the sums
   const CouplingMonitor& monitor() const { return monitor_; }
   // |G_d u_d + G_c u_c| / |G_d u_d| for the current displacements.
   double displacement_residual() const;

@@ -115,7 +115,7 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
   return a;
 }
 
-void BeamBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) const {
+void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
   const auto add_actions = [&p, this](std::size_t b, const Actions& a) {
     const std::uint32_t i = first_[b], j = second_[b];
     p.force[i] -= a.force_on_j;
@@ -123,8 +123,8 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) con
     p.torque[i] += a.torque_on_i;
     p.torque[j] += a.torque_on_j;
   };
-  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty();
-  if (!criterion && !virial) {  // the plain pass: no test per bond (measured 8-10 % faster)
+  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
+  if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
     for_each_bond(colouring_, [&](std::size_t b) { add_actions(b, actions(b, p)); });
     return;
   }
@@ -132,6 +132,7 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) con
     const Actions a = actions(b, p);
     add_actions(b, a);
     if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
+    if (energy) energy_record_[b] = energy_of(b, a);
     // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
     // scatters without races, in accumulate_virial's order.
     if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
@@ -157,8 +158,12 @@ double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
 double BeamBondSet::bond_energy(std::size_t b, const ParticleSet& p) const { return energy_of(b, actions(b, p)); }
 
 double BeamBondSet::energy(const ParticleSet& p) const {
-  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, energy_partial_,
+  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, sum_partial_,
                          [&](long b) { return bond_energy(static_cast<std::size_t>(b), p); });
+}
+
+void BeamBondSet::record_energies(const ParticleSet& p) const {
+  for_each_bond(colouring_, [&](std::size_t b) { energy_record_[b] = bond_energy(b, p); });
 }
 
 void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,

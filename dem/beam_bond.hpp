@@ -47,8 +47,9 @@ class BeamBondSet final : public BondSet {
   std::string_view law() const override { return "beam"; }
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
   void finalize(std::size_t n_particles) override;
-  void accumulate_forces(ParticleSet& p, const FailureScan& scan) const override;
+  void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
   double energy(const ParticleSet& p) const override;
+  void record_energies(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
   void scale_stiffness(std::span<const double> factor) override;
@@ -83,10 +84,9 @@ class BeamBondSet final : public BondSet {
   std::vector<double> torsion_;       // G J / L0, N m
   std::vector<Vec3> direction_;       // d0 (reference axis), unit
   std::vector<Vec3> normal_;          // p0 (perpendicular to d0), unit
-  // BBF's sigma per bond from the last force pass with FailureScan::criterion, Pa (scratch
+  // BBF's sigma per bond from the last force pass with ForceScan::criterion, Pa (scratch
   // sized by finalize, written by the force loop; one writer per bond).
   mutable std::vector<double> failure_stress_;
-  mutable std::vector<double> energy_partial_;  // energy()'s chunk sums (fixed_order_sum)
 };
 
 }  // namespace arlequin::dem

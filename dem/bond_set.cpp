@@ -34,4 +34,17 @@ std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> f
   return order;
 }
 
+double BondSet::recorded_energy() const {
+  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, sum_partial_,
+                         [this](long b) { return energy_record_[static_cast<std::size_t>(b)]; });
+}
+
+void BondSet::add_recorded_energy_per_particle(std::span<double> energy) const {
+  for (std::size_t b = 0; b < size(); ++b) {
+    const double half = 0.5 * energy_record_[b];
+    energy[first_[b]] += half;
+    energy[second_[b]] += half;
+  }
+}
+
 }  // namespace arlequin::dem

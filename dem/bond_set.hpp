@@ -5,8 +5,9 @@
 // store reference directions once per bond instead of once per end. finalize() is called
 // once after the last add() and before the first force evaluation. accumulate_forces() adds
 // (never overwrites) forces and torques: one virtual call per batch, none per bond. With a
-// FailureScan it also records, from the same per-bond kinematics, what the failure check of
-// that configuration needs, so a breakable step evaluates each bond once, not twice.
+// ForceScan it also records, from the same per-bond kinematics, what the failure check of
+// that configuration needs and each bond's energy, so a breakable step, or a step that ends on
+// an output row, evaluates each bond once, not twice or three times.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -74,11 +75,12 @@ inline void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t
 }
 
 // What a force pass records besides forces, for the failure check of the same configuration
-// (DemModel::apply_failures).
-struct FailureScan {
+// (DemModel::apply_failures) and for the energies of an output row.
+struct ForceScan {
   bool criterion = false;  // each bond's failure measure, read by find_failures()
   std::span<Sym3> virial;  // if not empty: every intact bond's virial added, as accumulate_virial()
   VirialBranch branch = VirialBranch::half;
+  bool energy = false;  // each bond's elastic energy, read by recorded_energies()
 };
 
 class BondSet {
@@ -87,9 +89,19 @@ class BondSet {
   virtual std::string_view law() const = 0;
   virtual void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) = 0;
   virtual void finalize(std::size_t n_particles) = 0;
-  virtual void accumulate_forces(ParticleSet& p, const FailureScan& scan) const = 0;
-  // Elastic energy stored in the batch, J.
+  virtual void accumulate_forces(ParticleSet& p, const ForceScan& scan) const = 0;
+  // Elastic energy stored in the batch in configuration p, J (no side effect).
   virtual double energy(const ParticleSet& p) const = 0;
+  // Each bond's elastic energy in configuration p into the record that a force pass with
+  // ForceScan::energy also fills (for when no such pass has seen p).
+  virtual void record_energies(const ParticleSet& p) const = 0;
+  // Each bond's elastic energy (J) of the configuration of the last accumulate_forces() with
+  // scan.energy or record_energies(); a broken bond's is 0. Their sum in a fixed order (the
+  // same bits on any thread count), and half of each added to both its DEs' entries (where the
+  // energy is, for energy sensors over a group).
+  std::span<const double> recorded_energies() const { return energy_record_; }
+  double recorded_energy() const;
+  void add_recorded_energy_per_particle(std::span<double> energy) const;
   // Adds to every DE's row the block-Gershgorin bound of omega^2 (rad^2/s^2) coming from this
   // batch, for its translational and rotational rows of M^-1/2 K M^-1/2 (Feingold-Varga:
   // lambda_max <= max_i sum_j ||A_ij||_2).
@@ -116,15 +128,6 @@ class BondSet {
     zero_stiffness(b);
   }
   std::span<const std::uint8_t> broken() const { return broken_; }
-  // Adds half of every bond's elastic energy to each of its DEs (J): where the energy is, for
-  // energy sensors over a group. Output-time use (one virtual call per bond).
-  void add_energy_per_particle(const ParticleSet& p, std::span<double> energy) const {
-    for (std::size_t b = 0; b < size(); ++b) {
-      const double half = 0.5 * bond_energy(b, p);
-      energy[first_[b]] += half;
-      energy[second_[b]] += half;
-    }
-  }
 
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }
@@ -137,12 +140,14 @@ class BondSet {
     second_.push_back(j);
     broken_.push_back(0);
   }
-  // Colours the pairs and reorders first/second/broken; returns the order for the law's arrays.
+  // Colours the pairs and reorders first/second/broken (sizes the energy record); returns the
+  // order for the law's arrays.
   std::vector<std::uint32_t> order_pairs(std::size_t n_particles) {
     auto order = colouring_.build(first_, second_, n_particles);
     apply_order(first_, order);
     apply_order(second_, order);
     apply_order(broken_, order);
+    energy_record_.assign(size(), 0.0);
     return order;
   }
   virtual void zero_stiffness(std::size_t b) = 0;
@@ -150,6 +155,10 @@ class BondSet {
   std::vector<std::uint32_t> first_, second_;
   std::vector<std::uint8_t> broken_;
   BondColouring colouring_;
+  // Scratch written by const passes (one writer per bond): the energy record, and the chunk
+  // sums of fixed_order_sum.
+  mutable std::vector<double> energy_record_;
+  mutable std::vector<double> sum_partial_;
 };
 
 // Registry of bond laws, keyed by the case-file name (dem.material.bond.law).

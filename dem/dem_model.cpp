@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "common/error.hpp"
 #include "dem/laguerre_cells.hpp"
@@ -160,9 +161,13 @@ void DemModel::advance_to_forces(double dt) {
   drift(dt);                          // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
   time_ += dt;
   update_neighbours();                // only with contact, only when a DE moved > skin/2
-  // Bonds, contacts -> f(n+1); breakable: also each bond's failure measure or virial.
-  compute_forces(failure_on_ ? failure_scan() : FailureScan{});
-  if (failure_on_) apply_failures();  // BBF / RDEF: break bonds, forces again if any broke
+  // Bonds, contacts -> f(n+1); breakable: also each bond's failure measure or virial; before
+  // an output row: also each bond's energy.
+  ForceScan scan = failure_on_ ? failure_scan() : ForceScan{};
+  scan.energy = std::exchange(energy_record_requested_, false);
+  compute_forces(scan);
+  if (failure_on_) apply_failures(scan.energy);  // BBF / RDEF: break bonds, forces again if any broke
+  energy_record_step_ = scan.energy ? steps_ + 1 : -1;
   record_reactions();                 // for sensors, and the work of driven DEs
   apply_loads_and_damping();          // dead loads, viscous damping
 }
@@ -239,14 +244,14 @@ void DemModel::update_neighbours() {
   if (neighbours_ && neighbours_->needs_rebuild(particles)) neighbours_->build(particles);
 }
 
-void DemModel::compute_forces(const FailureScan& scan) {
+void DemModel::compute_forces(const ForceScan& scan) {
   particles.clear_forces();
   for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
   if (contact_) contact_->accumulate_forces(*neighbours_, particles);
 }
 
-FailureScan DemModel::failure_scan() {
-  FailureScan scan;
+ForceScan DemModel::failure_scan() {
+  ForceScan scan;
   scan.criterion = true;
   if (rdef_) {
     rdef_stress_.assign(particles.size(), Sym3{});
@@ -264,7 +269,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> DemModel::intact_bonded_pai
   return pairs;
 }
 
-void DemModel::apply_failures() {
+void DemModel::apply_failures(bool record_energy) {
   new_breaks_.clear();
   for (std::size_t s = 0; s < bond_sets_.size(); ++s)
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
@@ -294,12 +299,15 @@ void DemModel::apply_failures() {
     fracture_ += e.energy;
     breaks_.push_back(e);
   }
-  // Former partners now meet by contact; the step's forces are recomputed without the bonds.
+  // Former partners now meet by contact; the step's forces (and the energy record) are
+  // recomputed without the bonds.
   if (neighbours_) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
-  compute_forces();
+  ForceScan scan;
+  scan.energy = record_energy;
+  compute_forces(scan);
 }
 
 void DemModel::average_over_bonded_neighbours(std::vector<Sym3>& sigma) {
@@ -409,13 +417,28 @@ void DemModel::apply_loads_and_damping() {
   }
 }
 
+void DemModel::use_energy_record() const {
+  if (energy_record_step_ == steps_) return;  // the last step's force pass recorded them
+  for (const auto& set : bond_sets_) set->record_energies(particles);
+}
+
+double DemModel::particle_kinetic_energy(std::size_t i) const {
+  const ParticleSet& p = particles;
+  return 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
+}
+
+double DemModel::kinetic_energy() const {
+  double e = 0.0;
+  for (std::size_t i = 0; i < particles.size(); ++i) e += particle_kinetic_energy(i);
+  return e;
+}
+
 Energies DemModel::energies() const {
   Energies e;
-  const ParticleSet& p = particles;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    e.kinetic += 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
-  for (const auto& set : bond_sets_) e.bond += set->energy(p);
-  if (contact_) e.contact = contact_->energy(*neighbours_, p);
+  e.kinetic = kinetic_energy();
+  use_energy_record();
+  for (const auto& set : bond_sets_) e.bond += set->recorded_energy();
+  if (contact_) e.contact = contact_->energy(*neighbours_, particles);
   e.external_work = external_work_;
   e.dissipated = dissipated_;
   e.fracture = fracture_;
@@ -440,14 +463,13 @@ Vec3 DemModel::mean_displacement(int group) const {
 }
 
 double DemModel::group_energy(int group) const {
-  std::vector<double> bond_energy(particles.size(), 0.0);
-  for (const auto& set : bond_sets_) set->add_energy_per_particle(particles, bond_energy);
+  use_energy_record();
+  bond_energy_share_.assign(particles.size(), 0.0);
+  for (const auto& set : bond_sets_) set->add_recorded_energy_per_particle(bond_energy_share_);
   const GroupMask bit = GroupMask{1} << group;
   double e = 0.0;
   for (std::size_t i = 0; i < particles.size(); ++i)
-    if (particles.groups[i] & bit)
-      e += bond_energy[i] + 0.5 * (particles.mass(i) * norm2(particles.velocity[i]) +
-                                   particles.inertia(i) * norm2(particles.angular_velocity[i]));
+    if (particles.groups[i] & bit) e += bond_energy_share_[i] + particle_kinetic_energy(i);
   return e;
 }
 

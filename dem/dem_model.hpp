@@ -107,7 +107,13 @@ class DemModel {
   // Fraction of each DE's bonds that are broken (0 for a DE without bonds).
   std::vector<double> damage() const;
 
+  // Output rows: the next step's force pass also records every bond's energy, so that
+  // energies() and group_energy() after that step read it instead of evaluating every bond
+  // again (without the request they evaluate the bonds themselves). The record is that of the
+  // step's configuration: code that moves DEs between steps must not make the request.
+  void record_energies_in_next_step() { energy_record_requested_ = true; }
   Energies energies() const;
+  double kinetic_energy() const;  // Energies::kinetic alone (no bond pass), J
   double external_work() const { return external_work_; }  // J, cheap (no energy sums)
   // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
   Vec3 reaction_on(int group) const { return reaction_[group]; }
@@ -128,12 +134,16 @@ class DemModel {
   void impose_motion(double t, bool half_step, double dt);
   void drift(double dt);
   void update_neighbours();
-  void compute_forces(const FailureScan& scan = {});
+  void compute_forces(const ForceScan& scan = {});
   // The scan that records, in the step's force pass, what apply_failures() needs (zeroes the
   // RDEF virial it accumulates into).
-  FailureScan failure_scan();
+  ForceScan failure_scan();
   void record_reactions();
-  void apply_failures();
+  void apply_failures(bool record_energy);  // record_energy: the forces' recomputation records too
+  // Makes the bond sets' energy records those of the current configuration (a pass over the
+  // bonds unless the last step's force pass recorded them).
+  void use_energy_record() const;
+  double particle_kinetic_energy(std::size_t i) const;  // DE i's, translation and rotation, J
   void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
   // Virial stress of every DE with the volume shares omega (m^3) and the bonds' branch vectors
   // to `branch`, into sigma (resized).
@@ -170,6 +180,9 @@ class DemModel {
   std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega
   std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (m^3)
   std::vector<double> rdef_omega_;       // RDEF: each DE's volume share Omega_i (m^3, finalize)
+  bool energy_record_requested_ = false;  // record_energies_in_next_step()
+  long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
+  mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE
   GroupMask watched_ = 0;
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;

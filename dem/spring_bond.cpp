@@ -40,13 +40,13 @@ Vec3 SpringBondSet::force_on_j(std::size_t b, const Stretch& s) const {
 
 Vec3 SpringBondSet::force_on_j(std::size_t b, const ParticleSet& p) const { return force_on_j(b, stretch(b, p)); }
 
-void SpringBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) const {
+void SpringBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
   const auto add_force = [&p, this](std::size_t b, const Vec3& f_j) {
     p.force[first_[b]] -= f_j;
     p.force[second_[b]] += f_j;
   };
-  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty();
-  if (!criterion && !virial) {  // the plain pass: no test per bond (as BeamBondSet)
+  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
+  if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (as BeamBondSet)
     for_each_bond(colouring_, [&](std::size_t b) { add_force(b, force_on_j(b, p)); });
     return;
   }
@@ -55,19 +55,25 @@ void SpringBondSet::accumulate_forces(ParticleSet& p, const FailureScan& scan) c
     const Vec3 f_j = force_on_j(b, s);
     add_force(b, f_j);
     if (criterion) elongation_[b] = s.length / rest_length_[b] - 1.0;
+    if (energy) energy_record_[b] = energy_of(b, s);
     if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -f_j, scan.branch, scan.virial);
   });
 }
 
-double SpringBondSet::bond_energy(std::size_t b, const ParticleSet& p) const {
-  const double stretch = norm(p.position[second_[b]] - p.position[first_[b]]) - rest_length_[b];
+double SpringBondSet::energy_of(std::size_t b, const Stretch& s) const {
+  const double stretch = s.length - rest_length_[b];
   return 0.5 * stiffness_[b] * stretch * stretch;
 }
 
+double SpringBondSet::bond_energy(std::size_t b, const ParticleSet& p) const { return energy_of(b, stretch(b, p)); }
+
 double SpringBondSet::energy(const ParticleSet& p) const {
-  double e = 0.0;
-  for (std::size_t b = 0; b < size(); ++b) e += bond_energy(b, p);
-  return e;
+  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, sum_partial_,
+                         [&](long b) { return bond_energy(static_cast<std::size_t>(b), p); });
+}
+
+void SpringBondSet::record_energies(const ParticleSet& p) const {
+  for_each_bond(colouring_, [&](std::size_t b) { energy_record_[b] = bond_energy(b, p); });
 }
 
 void SpringBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,

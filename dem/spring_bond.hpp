@@ -21,8 +21,9 @@ class SpringBondSet final : public BondSet {
   std::string_view law() const override { return "spring"; }
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
   void finalize(std::size_t n_particles) override;
-  void accumulate_forces(ParticleSet& p, const FailureScan& scan) const override;
+  void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
   double energy(const ParticleSet& p) const override;
+  void record_energies(const ParticleSet& p) const override;
   void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
                             std::span<double> rotational) const override;
   void scale_stiffness(std::span<const double> factor) override;
@@ -43,12 +44,13 @@ class SpringBondSet final : public BondSet {
   Stretch stretch(std::size_t b, const ParticleSet& p) const;
   Vec3 force_on_j(std::size_t b, const Stretch& s) const;
   Vec3 force_on_j(std::size_t b, const ParticleSet& p) const;
+  double energy_of(std::size_t b, const Stretch& s) const;
 
   double nominal_stiffness_;         // K of the case file, N/m
   double max_elongation_;            // 0 = unbreakable
   std::vector<double> stiffness_;    // K per bond (weighted), N/m
   std::vector<double> rest_length_;  // L0, m
-  // Elongation per bond from the last force pass with FailureScan::criterion (scratch sized
+  // Elongation per bond from the last force pass with ForceScan::criterion (scratch sized
   // by finalize; one writer per bond).
   mutable std::vector<double> elongation_;
 };

@@ -1,10 +1,12 @@
 // Bond failure against closed forms: BBF thresholds in pure tension and pure bending, springs at
 // their maximum elongation, no force after a break, the RDEF virial stress of a uniformly
 // strained lattice, RDEF breaking every bond of a DE, and contact between former partners.
-// Also: RDEF's shortcut threshold test against the full eigenvalue, and the force pass that
-// records the failure measures giving the same bits on 1 and 2 threads.
+// Also: RDEF's shortcut threshold test against the full eigenvalue, the force pass that
+// records the failure measures and energies giving the same bits on 1 and 2 threads, and the
+// output rows' energies read from that record.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -18,8 +20,8 @@ namespace arlequin::dem {
 namespace {
 
 // A force pass that records the failure measures, as a breakable step's does.
-FailureScan criterion_scan() {
-  FailureScan scan;
+ForceScan criterion_scan() {
+  ForceScan scan;
   scan.criterion = true;
   return scan;
 }
@@ -159,11 +161,105 @@ TEST(Rdef, ThresholdTestMatchesTheEquivalentStressExactly) {
   }
 }
 
+// A damped breakable model on a lattice of `counts` DEs: beams with BBF, springs with a
+// maximum elongation on the same pairs, and RDEF on Laguerre cells (radical branch), started
+// from random velocities that break bonds by every criterion within 40 steps. Returns the step.
+double build_breakable_model(DemModel& model, std::array<int, 3> counts) {
+  const double R = 1e-3, a = 2 * R;
+  build_lattice(model.particles, {0, 0, 0}, counts, a, R, 7800.0);
+  test::bond_all_touching(model, {2e11, 0.3, 0.5, 2.5e8});
+  auto springs = std::make_unique<SpringBondSet>(1e6, 4e-4);
+  for (auto [i, j] : close_pairs(model.particles, 0.01)) springs->add(i, j, model.particles);
+  model.add_bond_set(std::move(springs));
+  DemModel::RdefSettings rdef;
+  rdef.threshold = 1.0e7;
+  rdef.volume = RdefVolume::laguerre;
+  model.enable_rdef(rdef);
+  model.set_damping(0.05);
+  model.finalize();
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (auto& v : model.particles.velocity) v = Vec3{uni(rng), uni(rng), uni(rng)} * 2.0;  // m/s
+  return 0.5 * model.critical_time_step();
+}
+
+// Output rows read the bonds' energies that the step's force pass recorded (on request): the
+// same bits as a bond pass of their own, also in steps where bonds break (the forces and the
+// record are then taken again without them); steps without the request evaluate the bonds.
+TEST(ForceScan, RecordedEnergiesAreThoseOfABondPass) {
+  DemModel recorded, evaluated;
+  const double dt = build_breakable_model(recorded, {6, 5, 5});
+  build_breakable_model(evaluated, {6, 5, 5});
+  constexpr int group = 0;  // every third DE
+  for (DemModel* m : {&recorded, &evaluated})
+    for (std::size_t i = 0; i < m->particles.size(); i += 3) m->particles.groups[i] |= GroupMask{1} << group;
+  std::size_t steps_with_breaks = 0;
+  for (int n = 0; n < 40; ++n) {
+    if (n % 3 != 2) recorded.record_energies_in_next_step();  // every third step: none
+    const std::size_t before = recorded.breaks().size();
+    recorded.step(dt);
+    evaluated.step(dt);
+    steps_with_breaks += recorded.breaks().size() > before;
+    for (std::size_t i = 0; i < recorded.particles.size(); ++i) {  // recording changes no motion
+      ASSERT_EQ(recorded.particles.position[i], evaluated.particles.position[i]) << "step " << n << ", DE " << i;
+      ASSERT_EQ(recorded.particles.velocity[i], evaluated.particles.velocity[i]) << "step " << n << ", DE " << i;
+    }
+    const Energies a = recorded.energies(), b = evaluated.energies();
+    ASSERT_EQ(a.bond, b.bond) << "step " << n;
+    ASSERT_EQ(a.kinetic, b.kinetic) << "step " << n;
+    ASSERT_EQ(recorded.group_energy(group), evaluated.group_energy(group)) << "step " << n;
+  }
+  EXPECT_GT(steps_with_breaks, 3u);
+  // Per bond, the record is bond_energy() (0 for a broken bond).
+  for (const auto& set : recorded.bond_sets())
+    for (std::size_t b = 0; b < set->size(); ++b) {
+      ASSERT_EQ(set->recorded_energies()[b], set->bond_energy(b, recorded.particles)) << b;
+      if (set->broken()[b]) {
+        ASSERT_EQ(set->recorded_energies()[b], 0.0) << b;
+      }
+    }
+}
+
+// Whatever a force pass records (failure measures, virials, energies), its forces and torques
+// are the plain pass's to the bit, for beams and springs: output rows and failure checks leave
+// the motion unchanged. (Springs needed their file built without FMA contraction; see
+// dem/CMakeLists.txt.)
+TEST(ForceScan, RecordingLeavesTheForcesUnchanged) {
+  DemModel model;
+  build_breakable_model(model, {6, 5, 5});
+  ParticleSet& p = model.particles;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.position[i] += Vec3{uni(rng), uni(rng), uni(rng)} * 4e-6;  // m, 2e-3 of the spacing
+    p.orientation[i] = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 2e-3);
+  }
+  std::vector<Sym3> virial(p.size());
+  ASSERT_EQ(model.bond_sets().size(), 2u);  // beams and springs
+  for (const auto& set : model.bond_sets()) {
+    p.clear_forces();
+    set->accumulate_forces(p, ForceScan{});
+    const std::vector<Vec3> force = p.force, torque = p.torque;
+    for (int flags = 1; flags < 8; ++flags) {
+      ForceScan scan;
+      scan.criterion = flags & 1;
+      if (flags & 2) scan.virial = virial;
+      scan.energy = flags & 4;
+      p.clear_forces();
+      set->accumulate_forces(p, scan);
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        ASSERT_EQ(p.force[i], force[i]) << set->law() << ", scan " << flags << ", DE " << i;
+        ASSERT_EQ(p.torque[i], torque[i]) << set->law() << ", scan " << flags << ", DE " << i;
+      }
+    }
+  }
+}
+
 #ifdef _OPENMP
 // The force pass with a failure scan runs a colour's bonds on threads (above
 // parallel_threshold_bonds): forces, torques, BBF measures and virials are the same to the bit
 // on 1 and 2 threads, and so are the failures found.
-TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
+TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   DemModel model;
   const double R = 1e-3, a = 2 * R;
   build_lattice(model.particles, {0, 0, 0}, {16, 16, 16}, a, R, 7800.0);
@@ -180,18 +276,23 @@ TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
     std::vector<Vec3> force, torque;
     std::vector<Sym3> virial;
     std::vector<BreakEvent> events;
+    std::vector<double> energy;  // per bond
+    double total_energy;
   };
   const auto pass = [&](int threads) {
     const test::OmpThreads scope(threads);
     Pass out;
     out.virial.assign(p.size(), Sym3{});
-    FailureScan scan = criterion_scan();
+    ForceScan scan = criterion_scan();
     scan.virial = out.virial;
+    scan.energy = true;
     p.clear_forces();
     beam.accumulate_forces(p, scan);
     beam.find_failures(p, 0, 0.0, out.events);
     out.force = p.force;
     out.torque = p.torque;
+    out.energy.assign(beam.recorded_energies().begin(), beam.recorded_energies().end());
+    out.total_energy = beam.recorded_energy();
     return out;
   };
   const Pass one = pass(1), two = pass(2);
@@ -209,17 +310,24 @@ TEST(FailureScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
     EXPECT_EQ(one.events[k].bond, two.events[k].bond);
     EXPECT_EQ(one.events[k].stress, two.events[k].stress);
   }
-  // The virial of the force pass is accumulate_virial's.
+  // The virial of the force pass is accumulate_virial's; the energies are bond_energy()'s and
+  // their sum energy()'s.
   std::vector<Sym3> reference(p.size(), Sym3{});
   beam.accumulate_virial(p, VirialBranch::half, reference);
   for (std::size_t i = 0; i < p.size(); ++i) ASSERT_EQ(reference[i], one.virial[i]) << i;
+  for (std::size_t b = 0; b < beam.size(); ++b) {
+    ASSERT_EQ(one.energy[b], two.energy[b]) << b;
+    ASSERT_EQ(one.energy[b], beam.bond_energy(b, p)) << b;
+  }
+  EXPECT_EQ(one.total_energy, two.total_energy);
+  EXPECT_EQ(one.total_energy, beam.energy(p));
 }
 
 // Whole steps of a damped breakable model on 1 and 2 threads: beams with BBF, springs with a
 // maximum elongation on the same pairs, and RDEF on Laguerre cells (radical branch), started
 // from random velocities that break bonds by every criterion within the run. Same breaks, same
 // positions and the same energies (bond, damping work), to the bit.
-TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
+TEST(ForceScan, BreakableStepsAreTheSameOnAnyThreadCount) {
   struct Run {
     std::vector<Vec3> position;
     std::vector<BreakEvent> breaks;
@@ -228,22 +336,7 @@ TEST(FailureScan, BreakableStepsAreTheSameOnAnyThreadCount) {
   const auto run = [](int threads) {
     const test::OmpThreads scope(threads);
     DemModel model;
-    const double R = 1e-3, a = 2 * R;
-    build_lattice(model.particles, {0, 0, 0}, {17, 16, 16}, a, R, 7800.0);  // above parallel_threshold DEs
-    test::bond_all_touching(model, {2e11, 0.3, 0.5, 2.5e8});
-    auto springs = std::make_unique<SpringBondSet>(1e6, 4e-4);
-    for (auto [i, j] : close_pairs(model.particles, 0.01)) springs->add(i, j, model.particles);
-    model.add_bond_set(std::move(springs));
-    DemModel::RdefSettings rdef;
-    rdef.threshold = 1.0e7;
-    rdef.volume = RdefVolume::laguerre;
-    model.enable_rdef(rdef);
-    model.set_damping(0.05);
-    model.finalize();
-    std::mt19937 rng(9);
-    std::uniform_real_distribution<double> uni(-1.0, 1.0);
-    for (auto& v : model.particles.velocity) v = Vec3{uni(rng), uni(rng), uni(rng)} * 2.0;  // m/s
-    const double dt = 0.5 * model.critical_time_step();
+    const double dt = build_breakable_model(model, {17, 16, 16});  // above parallel_threshold DEs
     for (int n = 0; n < 40; ++n) model.step(dt);
     return Run{model.particles.position, model.breaks(), model.energies()};
   };
