@@ -50,30 +50,62 @@ ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings) : mesh_(Mesh
 
 ContinuumSolver::~ContinuumSolver() = default;
 
-void ContinuumSolver::finish_setup() {
-  // Counting sort of the point entries by node, points in increasing order within a node.
-  const int nq = static_cast<int>(points_.x.size());
-  by_node_.offset.assign(static_cast<size_t>(num_nodes()) + 1, 0);
-  for (int J : points_.node) ++by_node_.offset[J + 1];
-  for (int J = 0; J < num_nodes(); ++J) by_node_.offset[J + 1] += by_node_.offset[J];
-  by_node_.point.resize(points_.node.size());
-  by_node_.grad.resize(points_.node.size());
-  std::vector<int> next(by_node_.offset.begin(), by_node_.offset.end() - 1);
-  for (int q = 0; q < nq; ++q)
-    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
-      const int slot = next[points_.node[k]]++;
-      by_node_.point[slot] = q;
-      by_node_.grad[slot] = points_.grad[k];
-    }
-  point_stress_.assign(static_cast<size_t>(nq), Voigt::Zero());
-  set_weight([](const Vec3&) { return 1.0; });
-}
+void ContinuumSolver::finish_setup() { set_weight([](const Vec3&) { return 1.0; }); }
 
 void ContinuumSolver::set_weight(ScalarFunction alpha) {
   alpha_ = std::move(alpha);
   point_weight_.resize(points_.x.size());
   for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
   mass_ = weighted_lumped_mass(alpha_);
+  stiffness_current_ = false;
+}
+
+std::vector<std::vector<int>> ContinuumSolver::coupled_nodes(int node0, int node1) const {
+  std::vector<std::vector<int>> adj(static_cast<size_t>(node1 - node0));
+  for (size_t q = 0; q + 1 < points_.offset.size(); ++q)
+    for (int a = points_.offset[q]; a < points_.offset[q + 1]; ++a) {
+      const int i = points_.node[a];
+      if (i < node0 || i >= node1) continue;
+      for (int b = points_.offset[q]; b < points_.offset[q + 1]; ++b) adj[i - node0].push_back(points_.node[b]);
+    }
+  for (auto& a : adj) {
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  }
+  return adj;
+}
+
+void ContinuumSolver::point_stiffness(int q, std::vector<int>& nodes, std::vector<double>& Ke) const {
+  const int b0 = points_.offset[q], m = points_.offset[q + 1] - b0;
+  const Stiffness C = point_weight_[q] * materials_[points_.material[q]].C;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, 3 * m);
+  nodes.resize(m);
+  for (int a = 0; a < m; ++a) {
+    const Vec3& g = points_.grad[b0 + a];
+    nodes[a] = points_.node[b0 + a];
+    B(0, 3 * a) = g.x;
+    B(1, 3 * a + 1) = g.y;
+    B(2, 3 * a + 2) = g.z;
+    B(3, 3 * a + 1) = g.z, B(3, 3 * a + 2) = g.y;
+    B(4, 3 * a) = g.z, B(4, 3 * a + 2) = g.x;
+    B(5, 3 * a) = g.y, B(5, 3 * a + 1) = g.x;
+  }
+  Ke.resize(static_cast<size_t>(9 * m * m));
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(Ke.data(), 3 * m, 3 * m) =
+      B.transpose() * C * B;
+}
+
+const BlockMatrix3& ContinuumSolver::stiffness() const {
+  if (stiffness_current_) return stiffness_;
+  stiffness_ = BlockMatrix3(coupled_nodes(0, num_nodes()));
+  std::vector<int> point_nodes;
+  std::vector<double> Ke;
+  for (int q = 0; q + 1 < static_cast<int>(points_.offset.size()); ++q) {
+    point_stiffness(q, point_nodes, Ke);
+    stiffness_.add(point_nodes, Ke.data());
+  }
+  stiffness_current_ = true;
+  return stiffness_;
 }
 
 void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> components, VectorFunction g) {
@@ -143,32 +175,9 @@ Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
   return e;
 }
 
-// f_int = sum_q w_q B_q^T C_q B_q u in two loops: the weighted stress s_q = w_q C_q B_q u of
-// every point, then per node J the sum of B_qJ^T s_q over the points that hold it (by_node_).
-// Each loop writes only its own entries, so both run over threads as they are; each is one pass
-// over the entries (points_.node), the measure of its work.
-void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
-  f_int.resize(u.size());
-  const long nq = static_cast<long>(points_.x.size()), nn = num_nodes();
-  const bool parallel = static_cast<long>(points_.node.size()) > parallel_threshold;
-#pragma omp parallel for schedule(static) if (parallel)
-  for (long q = 0; q < nq; ++q)
-    point_stress_[q] = point_weight_[q] * (materials_[points_.material[q]].C * strain_at(static_cast<int>(q), u));
-#pragma omp parallel for schedule(static) if (parallel)
-  for (long J = 0; J < nn; ++J) {
-    double fx = 0, fy = 0, fz = 0;
-    for (int k = by_node_.offset[J]; k < by_node_.offset[J + 1]; ++k) {
-      const Vec3& g = by_node_.grad[k];
-      const Voigt& s = point_stress_[by_node_.point[k]];
-      fx += g.x * s[0] + g.z * s[4] + g.y * s[5];
-      fy += g.y * s[1] + g.z * s[3] + g.x * s[5];
-      fz += g.z * s[2] + g.y * s[3] + g.x * s[4];
-    }
-    f_int[3 * J] = fx;
-    f_int[3 * J + 1] = fy;
-    f_int[3 * J + 2] = fz;
-  }
-}
+// f_int = sum_q w_q B_q^T C_q B_q u = K u, K assembled once per weight (block_matrix.hpp says
+// why).
+void ContinuumSolver::internal_force(const Field& u, Field& f_int) const { stiffness().multiply(u, f_int); }
 
 void ContinuumSolver::add_external_force(Field& f) const {
   for (const Traction& tr : tractions_) {
@@ -266,22 +275,13 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   const int node0 = static_cast<int>((row_end - n_local) / 3), node1 = static_cast<int>(row_end / 3);
 
   // Block sparsity of the local rows: nodes sharing an integration point are coupled.
-  std::vector<std::vector<int>> adj(node1 - node0);
+  const std::vector<std::vector<int>> adj = coupled_nodes(node0, node1);
   const int nq = static_cast<int>(points_.x.size());
-  for (int q = 0; q < nq; ++q)
-    for (int a = points_.offset[q]; a < points_.offset[q + 1]; ++a) {
-      const int i = points_.node[a];
-      if (i < node0 || i >= node1) continue;
-      for (int b = points_.offset[q]; b < points_.offset[q + 1]; ++b) adj[i - node0].push_back(points_.node[b]);
-    }
   std::vector<PetscInt> d_nnz(node1 - node0), o_nnz(node1 - node0);
   for (int i = 0; i < node1 - node0; ++i) {
-    auto& a = adj[i];
-    std::sort(a.begin(), a.end());
-    a.erase(std::unique(a.begin(), a.end()), a.end());
+    const auto& a = adj[i];
     d_nnz[i] = static_cast<PetscInt>(std::count_if(a.begin(), a.end(), [&](int j) { return j >= node0 && j < node1; }));
     o_nnz[i] = static_cast<PetscInt>(a.size()) - d_nnz[i];
-    std::vector<int>().swap(a);
   }
 
   Mat K;
@@ -290,25 +290,15 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(MatSetType(K, MATAIJ), "MatSetType");
   check(MatSetBlockSize(K, 3), "MatSetBlockSize");
   check(MatXAIJSetPreallocation(K, 3, d_nnz.data(), o_nnz.data(), nullptr, nullptr), "MatXAIJSetPreallocation");
+  std::vector<int> point_nodes;
   std::vector<PetscInt> idx;
+  std::vector<double> Ke;
   const int q0 = static_cast<int>(static_cast<long long>(nq) * rank / size);
   const int q1 = static_cast<int>(static_cast<long long>(nq) * (rank + 1) / size);
   for (int q = q0; q < q1; ++q) {
-    const int b0 = points_.offset[q], m = points_.offset[q + 1] - b0;
-    const Stiffness C = point_weight_[q] * materials_[points_.material[q]].C;
-    Eigen::Matrix<double, 6, Eigen::Dynamic> B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, 3 * m);
-    idx.resize(m);
-    for (int a = 0; a < m; ++a) {
-      const Vec3& g = points_.grad[b0 + a];
-      idx[a] = points_.node[b0 + a];
-      B(0, 3 * a) = g.x;
-      B(1, 3 * a + 1) = g.y;
-      B(2, 3 * a + 2) = g.z;
-      B(3, 3 * a + 1) = g.z, B(3, 3 * a + 2) = g.y;
-      B(4, 3 * a) = g.z, B(4, 3 * a + 2) = g.x;
-      B(5, 3 * a) = g.y, B(5, 3 * a + 1) = g.x;
-    }
-    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> Ke = B.transpose() * C * B;
+    point_stiffness(q, point_nodes, Ke);
+    idx.assign(point_nodes.begin(), point_nodes.end());
+    const PetscInt m = static_cast<PetscInt>(point_nodes.size());
     check(MatSetValuesBlocked(K, m, idx.data(), m, idx.data(), Ke.data(), ADD_VALUES), "MatSetValuesBlocked");
   }
   check(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
@@ -398,12 +388,10 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
 }
 
 double ContinuumSolver::strain_energy() const {
+  internal_force(u_, ku_);
   double e = 0;
-  for (int q = 0; q < static_cast<int>(points_.x.size()); ++q) {
-    const Voigt eps = strain_at(q, u_);
-    e += 0.5 * point_weight_[q] * eps.dot(materials_[points_.material[q]].C * eps);
-  }
-  return e;
+  for (size_t d = 0; d < u_.size(); ++d) e += u_[d] * ku_[d];
+  return 0.5 * e;
 }
 
 double ContinuumSolver::kinetic_energy() const {

@@ -8,8 +8,9 @@
 //  - Weight alpha(x) (Arlequin, default 1) multiplies every volume integrand: the lumped mass,
 //    the internal force, the stiffness and the strain energy. The caller applies any mass floor.
 //  - Strain at integration point q is B_q u (constant per point); forces and energies are sums
-//    over points: f_int = sum_q w_q B_q^T C_q B_q u, E_strain = 1/2 sum_q w_q eps_q.C_q eps_q,
-//    with w_q = alpha(x_q) |cell_q|.
+//    over points: f_int = sum_q w_q B_q^T C_q B_q u = K u, E_strain = 1/2 sum_q w_q
+//    eps_q.C_q eps_q = 1/2 u.K u, with w_q = alpha(x_q) |cell_q|. K is assembled once per
+//    weight (a BlockMatrix3), so a step and an energy cost one pass over K's blocks.
 //  - `interpolation(points)` returns the sparse operator N (rows: points, columns: nodes) with
 //    u(point_p) = sum_I N(p, I) u_I per component; points outside the body are an InputError.
 //  - Essential BCs act on named physical groups and fix chosen components to g(X, t); loads are
@@ -32,6 +33,7 @@
 #include <vector>
 
 #include "common/vec3.hpp"
+#include "continuum/block_matrix.hpp"
 #include "continuum/material.hpp"
 #include "continuum/mesh.hpp"
 
@@ -103,6 +105,7 @@ class ContinuumSolver {
 
   // Integration points, for output and checks: positions and strain / stress (Voigt).
   const std::vector<Vec3>& point_positions() const { return points_.x; }
+  const std::vector<double>& point_weights() const { return point_weight_; }  // alpha(x_q) |cell_q|, m^3
   std::vector<Voigt> point_strain() const;
   std::vector<Voigt> point_stress() const;
 
@@ -152,21 +155,23 @@ class ContinuumSolver {
   void add_external_force(Field& f) const;
   double prescribed(const Fixed& f, double t) const;
 
-  // The points' gradients regrouped by node (finish_setup): node J's internal force is the sum
-  // over its entries (q, g) of g . s_q, s_q the weighted stress of point q, so internal_force
-  // runs over points and then over nodes, each loop free of write conflicts between threads.
-  struct PointsByNode {
-    std::vector<int> offset{0};
-    std::vector<int> point;
-    std::vector<Vec3> grad;
-  };
+  // For every node in [node0, node1), the sorted nodes it shares an integration point with
+  // (itself included): K's block pattern (the explicit K and the static solve's local rows).
+  std::vector<std::vector<int>> coupled_nodes(int node0, int node1) const;
+  // Point q's w_q B_q^T C_q B_q over its nodes (`nodes`, m of them): (3 m) x (3 m), row-major,
+  // i.e. m x m blocks of 3 x 3 (PETSc's blocked layout).
+  void point_stiffness(int q, std::vector<int>& nodes, std::vector<double>& Ke) const;
+  // K = sum_q w_q B_q^T C_q B_q, assembled on first use after the weight was set.
+  const BlockMatrix3& stiffness() const;
 
   ScalarFunction alpha_;
   std::vector<double> point_weight_;  // alpha(x_q) volume_q
-  PointsByNode by_node_;
-  // internal_force's s_q, kept between calls so that a step allocates nothing (one caller at a
-  // time per solver, as for every other state).
-  mutable std::vector<Voigt> point_stress_;
+  // stiffness()'s K and whether it is that of the current weights; strain_energy()'s K u. Kept
+  // between calls so that nothing is allocated per step (one caller at a time per solver, as
+  // for every other state).
+  mutable BlockMatrix3 stiffness_;
+  mutable bool stiffness_current_ = false;
+  mutable Field ku_;
   std::vector<double> mass_;
   std::vector<Fixed> fixed_;
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)
