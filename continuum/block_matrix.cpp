@@ -36,6 +36,8 @@ void BlockMatrix3::add(const std::vector<int>& nodes, const double* dense) {
 }
 
 void BlockMatrix3::multiply(const std::vector<double>& x, std::vector<double>& y) const {
+  if (x.size() != 3 * static_cast<std::size_t>(rows())) throw std::invalid_argument("BlockMatrix3::multiply: x needs 3 values per row");
+  if (&x == &y) throw std::invalid_argument("BlockMatrix3::multiply: x and y must differ");
   y.resize(x.size());
   const long n = rows();
 #pragma omp parallel for schedule(static) if (static_cast<long>(column_.size()) > parallel_threshold)

@@ -9,8 +9,9 @@
 //
 // Contract: the pattern is fixed at construction (sorted column lists per row, each with the
 // diagonal); add() accumulates into an existing block (std::logic_error for a block outside the
-// pattern); multiply() writes y = K x (x, y of 3 values per node), each row summed in column
-// order, on threads for large matrices, with the same bits on any thread count.
+// pattern); multiply() writes y = K x (x of 3 values per row, y a different vector, resized),
+// each row summed in column order, on threads for large matrices, with the same bits on any
+// thread count (std::invalid_argument for a wrong size or y aliasing x).
 #pragma once
 #include <array>
 #include <vector>

@@ -275,13 +275,15 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   const int node0 = static_cast<int>((row_end - n_local) / 3), node1 = static_cast<int>(row_end / 3);
 
   // Block sparsity of the local rows: nodes sharing an integration point are coupled.
-  const std::vector<std::vector<int>> adj = coupled_nodes(node0, node1);
   const int nq = static_cast<int>(points_.x.size());
   std::vector<PetscInt> d_nnz(node1 - node0), o_nnz(node1 - node0);
-  for (int i = 0; i < node1 - node0; ++i) {
-    const auto& a = adj[i];
-    d_nnz[i] = static_cast<PetscInt>(std::count_if(a.begin(), a.end(), [&](int j) { return j >= node0 && j < node1; }));
-    o_nnz[i] = static_cast<PetscInt>(a.size()) - d_nnz[i];
+  {
+    const std::vector<std::vector<int>> adj = coupled_nodes(node0, node1);
+    for (int i = 0; i < node1 - node0; ++i) {
+      const auto& a = adj[i];
+      d_nnz[i] = static_cast<PetscInt>(std::count_if(a.begin(), a.end(), [&](int j) { return j >= node0 && j < node1; }));
+      o_nnz[i] = static_cast<PetscInt>(a.size()) - d_nnz[i];
+    }
   }
 
   Mat K;

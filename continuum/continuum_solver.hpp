@@ -100,6 +100,9 @@ class ContinuumSolver {
   void solve_static(const std::string& petsc_options = "");
 
   void internal_force(const Field& u, Field& f_int) const;
+  // 1/2 u.K u: one pass over K. A rigid part of u cancels to round-off eps |K| |u|^2 (the point
+  // sum's was second order in eps); far below the energies of these cases, but a state with a
+  // rigid motion 1e6 times its strains would see it.
   double strain_energy() const;
   double kinetic_energy() const;
 

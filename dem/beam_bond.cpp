@@ -163,7 +163,7 @@ double BeamBondSet::energy(const ParticleSet& p) const {
 }
 
 void BeamBondSet::record_energies(const ParticleSet& p) const {
-  for_each_bond(colouring_, [&](std::size_t b) { energy_record_[b] = bond_energy(b, p); });
+  record_each([&](std::size_t b) { return bond_energy(b, p); });
 }
 
 void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,

@@ -90,7 +90,7 @@ class BondSet {
   virtual void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) = 0;
   virtual void finalize(std::size_t n_particles) = 0;
   virtual void accumulate_forces(ParticleSet& p, const ForceScan& scan) const = 0;
-  // Elastic energy stored in the batch in configuration p, J (no side effect).
+  // Elastic energy stored in the batch in configuration p, J (leaves the record alone).
   virtual double energy(const ParticleSet& p) const = 0;
   // Each bond's elastic energy in configuration p into the record that a force pass with
   // ForceScan::energy also fills (for when no such pass has seen p).
@@ -126,6 +126,7 @@ class BondSet {
   void break_bond(std::size_t b) {
     broken_[b] = 1;
     zero_stiffness(b);
+    energy_record_[b] = 0.0;
   }
   std::span<const std::uint8_t> broken() const { return broken_; }
 
@@ -139,16 +140,25 @@ class BondSet {
     first_.push_back(i);
     second_.push_back(j);
     broken_.push_back(0);
+    energy_record_.push_back(0.0);
   }
-  // Colours the pairs and reorders first/second/broken (sizes the energy record); returns the
-  // order for the law's arrays.
+  // Colours the pairs and reorders first/second/broken/the energy record; returns the order
+  // for the law's arrays.
   std::vector<std::uint32_t> order_pairs(std::size_t n_particles) {
     auto order = colouring_.build(first_, second_, n_particles);
     apply_order(first_, order);
     apply_order(second_, order);
     apply_order(broken_, order);
-    energy_record_.assign(size(), 0.0);
+    apply_order(energy_record_, order);
     return order;
+  }
+  // record_energies(): energy_record_[b] = bond_energy(b) for every bond (finalized or not:
+  // each bond writes only its own entry, so no colouring is needed).
+  template <class BondEnergy>
+  void record_each(BondEnergy&& bond_energy) const {
+    const long n = static_cast<long>(size());
+#pragma omp parallel for schedule(static) if (n > parallel_threshold_bonds)
+    for (long b = 0; b < n; ++b) energy_record_[b] = bond_energy(static_cast<std::size_t>(b));
   }
   virtual void zero_stiffness(std::size_t b) = 0;
 

@@ -498,7 +498,7 @@ void DemModel::check_energy(double energy_limit) const {
   std::size_t fastest = 0;
   double fastest_energy = -1.0, kinetic = 0.0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double e = 0.5 * (p.mass(i) * norm2(p.velocity[i]) + p.inertia(i) * norm2(p.angular_velocity[i]));
+    const double e = particle_kinetic_energy(i);
     kinetic += e;
     if (e > fastest_energy) fastest_energy = e, fastest = i;
   }

@@ -20,7 +20,7 @@
 //   the patch tests hold for any a), stiffening the grid-scale modes: a larger a lowers the
 //   dispersion of a coarse cloud and raises its cut-off, but stiffens bending on coarse clouds
 //   (cantilever_continuum at size 0.5: tip error 0.4 % at a = 1, 4.2 % at 1.6) and a point then couples every node of its
-//   cell (K has more blocks: steps ~1.6x dearer); continuum/README.md has the measurements. Plain SCNI (a -> 0)
+//   cell (K has more blocks: steps ~1.4x dearer); continuum/README.md has the measurements. Plain SCNI (a -> 0)
 //   has spurious low-energy modes in 3D: on the unit cube, the lowest Dirichlet eigenvalues of
 //   M^-1 K were oscillating modes at 1/7 of the lowest FE one, with an error that did not
 //   decrease under refinement (L2 rate 0.9).

@@ -1,6 +1,9 @@
 // Shared set-up for the continuum tests: mesh paths, settings, affine fields, patch tests.
 #pragma once
+#include <gtest/gtest.h>
+
 #include <algorithm>
+#include <random>
 #include <string>
 
 #include "continuum/registry.hpp"
@@ -55,6 +58,32 @@ inline PatchErrors patch_test(ContinuumSolver& s, const Material& mat, bool trac
   }
   for (const Voigt& st : s.point_stress()) e.stress = std::max(e.stress, (st - sigma).norm() / sigma.norm());
   return e;
+}
+
+// internal_force and strain_energy use the assembled K (ContinuumSolver::stiffness). Checked
+// against the integration points themselves: E(w) = 1/2 sum_q w_q eps_q.C eps_q from
+// point_strain() and point_stress(), and the bilinear form f_int(u).v = a(u, v) =
+// (E(u + v) - E(u - v)) / 2, for random u and v.
+inline void expect_force_is_the_points_bilinear_form(ContinuumSolver& s) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uni(-1e-3, 1e-3);
+  Field u(s.displacement().size()), v(u.size());
+  for (double& x : u) x = uni(rng);
+  for (double& x : v) x = uni(rng);
+  const auto energy_of = [&](double sign) {
+    for (size_t d = 0; d < u.size(); ++d) s.displacement()[d] = u[d] + sign * v[d];
+    const std::vector<Voigt> strain = s.point_strain(), stress = s.point_stress();
+    double e = 0;
+    for (size_t q = 0; q < strain.size(); ++q) e += 0.5 * s.point_weights()[q] * strain[q].dot(stress[q]);
+    EXPECT_NEAR(s.strain_energy() / e, 1.0, 1e-12);
+    return e;
+  };
+  const double a_uv = 0.5 * (energy_of(1.0) - energy_of(-1.0));
+  Field f;
+  s.internal_force(u, f);
+  double fv = 0;
+  for (size_t d = 0; d < u.size(); ++d) fv += f[d] * v[d];
+  EXPECT_NEAR(fv / a_uv, 1.0, 1e-10);
 }
 
 }  // namespace arlequin::continuum::testing

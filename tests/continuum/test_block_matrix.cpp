@@ -1,13 +1,16 @@
 // BlockMatrix3 against a dense product: random point matrices added over overlapping node lists
 // (as the stiffness assembly does), then y = K x against the dense K built from the same
-// contributions; a block outside the pattern is refused.
+// contributions; a block outside the pattern is refused; and a matrix large enough for threads
+// gives the same bits on 1 and 2 threads.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <stdexcept>
 
+#include "common/parallel.hpp"
 #include "continuum/block_matrix.hpp"
+#include "support/omp_threads.hpp"
 
 namespace arlequin::continuum {
 namespace {
@@ -49,6 +52,36 @@ TEST(BlockMatrix3, MultiplyEqualsTheDenseSumOfTheContributions) {
   EXPECT_EQ(K.rows(), n);
   EXPECT_THROW(K.block(0, 4), std::logic_error);  // nodes 0 and 4 share no list
 }
+
+#ifdef _OPENMP
+TEST(BlockMatrix3, MultiplyIsTheSameOnAnyThreadCount) {
+  // A chain of 4000 nodes, each coupled to the next 3: ~28 000 blocks, above the threshold.
+  const int n = 4000;
+  std::vector<std::vector<int>> columns(n);
+  for (int i = 0; i < n; ++i)
+    for (int j = std::max(0, i - 3); j <= std::min(n - 1, i + 3); ++j) columns[i].push_back(j);
+  BlockMatrix3 K(columns);
+  ASSERT_GT(static_cast<long>(K.blocks()), parallel_threshold);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (int i = 0; i < n; ++i)
+    for (int j : columns[i])
+      for (double& v : K.block(i, j)) v = uni(rng);
+  std::vector<double> x(3 * n), one, two;
+  for (double& v : x) v = uni(rng);
+  {
+    const test::OmpThreads scope(1);
+    K.multiply(x, one);
+  }
+  {
+    const test::OmpThreads scope(2);
+    K.multiply(x, two);
+  }
+  EXPECT_EQ(one, two);
+  EXPECT_THROW(K.multiply(one, one), std::invalid_argument);
+  EXPECT_THROW(K.multiply(std::vector<double>(5), two), std::invalid_argument);
+}
+#endif
 
 }  // namespace
 }  // namespace arlequin::continuum

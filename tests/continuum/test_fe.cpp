@@ -51,6 +51,13 @@ double energy_growth(const std::string& method, int order, double factor, int st
 TEST(ContinuumFe, PatchTestP1) { fe_patch_test(1); }
 TEST(ContinuumFe, PatchTestP2) { fe_patch_test(2); }
 
+// The force and the energy from K against the tetrahedra's points, P1 and P2.
+TEST(ContinuumFe, InternalForceIsTheBilinearFormOfThePoints) {
+  for (int order : {1, 2})
+    expect_force_is_the_points_bilinear_form(
+        *make_continuum_solver("fe", settings("unit_cube.geo", 0.3, order, Material::isotropic(1e3, 0.3, 1.0))));
+}
+
 TEST(ContinuumFe, InterpolationOperatorReproducesAffineFields) {
   for (int order : {1, 2}) {
     auto s = make_continuum_solver("fe", settings("unit_cube.geo", 0.4, order, Material::isotropic(1, 0.3, 1)));

@@ -4,7 +4,6 @@
 
 #include "continuum/nem/nem_solver.hpp"
 #include "convergence_util.hpp"
-#include "support/omp_threads.hpp"
 
 using namespace arlequin;
 using namespace arlequin::continuum;
@@ -163,41 +162,8 @@ TEST(ContinuumNem, StabilizationScalesTheWithinCellEnergy) {
   EXPECT_GT(four - one, 1.5);  // the within-cell part carries most of the mode
 }
 
-// internal_force and strain_energy use the assembled K (ContinuumSolver::stiffness). Checked
-// against the points themselves: E(w) = 1/2 sum_q w_q eps_q.C eps_q from point_strain() and
-// point_stress(), the bilinear form f_int(u).v = a(u, v) = (E(u + v) - E(u - v)) / 2; and the
-// same to the bit on one and on two threads, as every row's sum runs in a fixed order.
-TEST(ContinuumNem, InternalForceIsTheBilinearFormOfThePointsOnAnyThreadCount) {
-  auto s = make_nem(0.3, "sibson", 1.9);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> uni(-1e-3, 1e-3);
-  Field u(s->displacement().size()), v(u.size());
-  for (double& x : u) x = uni(rng);
-  for (double& x : v) x = uni(rng);
-  const auto energy_of = [&](double sign) {
-    for (size_t d = 0; d < u.size(); ++d) s->displacement()[d] = u[d] + sign * v[d];
-    const std::vector<Voigt> strain = s->point_strain(), stress = s->point_stress();
-    double e = 0;
-    for (size_t q = 0; q < strain.size(); ++q) e += 0.5 * s->point_weights()[q] * strain[q].dot(stress[q]);
-    EXPECT_NEAR(s->strain_energy() / e, 1.0, 1e-12);
-    return e;
-  };
-  const double a_uv = 0.5 * (energy_of(1.0) - energy_of(-1.0));
-  Field f;
-  s->internal_force(u, f);
-  double fv = 0;
-  for (size_t d = 0; d < u.size(); ++d) fv += f[d] * v[d];
-  EXPECT_NEAR(fv / a_uv, 1.0, 1e-10);
-#ifdef _OPENMP
-  Field f_one, f_two;
-  {
-    const test::OmpThreads one(1);
-    s->internal_force(u, f_one);
-  }
-  {
-    const test::OmpThreads two(2);
-    s->internal_force(u, f_two);
-  }
-  EXPECT_EQ(f_one, f_two);
-#endif
+// The force and the energy from K against the sub-cell points (stabilised: each point couples
+// its whole cell).
+TEST(ContinuumNem, InternalForceIsTheBilinearFormOfThePoints) {
+  expect_force_is_the_points_bilinear_form(*make_nem(0.3, "sibson", 1.9));
 }
