@@ -29,18 +29,24 @@ double seconds_since(Clock::time_point t0) {
 constexpr const char* energy_columns[] = {"E_kinetic",    "E_bond",     "E_contact", "W_external",
                                           "E_dissipated", "E_fracture", "E_total",   "E_balance"};
 
-// Writes the output files of one run; every file is replaced atomically.
 double coupling_work(const Scene& scene) {
   return scene.continuum && scene.continuum->is_coupled() ? scene.continuum->coupling_work() : 0.0;
 }
 
-// Stored energy of the whole scene: DEM kinetic + bond + contact, continuum kinetic + strain.
-double scene_total(const Scene& scene, const dem::Energies& e) {
-  double total = e.total();
-  if (scene.continuum) total += scene.continuum->kinetic_energy() + scene.continuum->strain_energy();
-  return total;
+// The continuum's kinetic and strain energy, J (0 without a continuum); each is a pass over
+// the continuum, so a row takes them once.
+struct ContinuumEnergies {
+  double kinetic = 0.0, strain = 0.0;
+};
+ContinuumEnergies continuum_energies(const Scene& scene) {
+  if (!scene.continuum) return {};
+  return {scene.continuum->kinetic_energy(), scene.continuum->strain_energy()};
 }
 
+// Stored energy of the whole scene: DEM kinetic + bond + contact, continuum kinetic + strain.
+double scene_total(const dem::Energies& e, const ContinuumEnergies& c) { return e.total() + c.kinetic + c.strain; }
+
+// Writes the output files of one run; every file is replaced atomically.
 class Outputs {
  public:
   Outputs(const Scene& scene) : scene_(scene) {
@@ -74,14 +80,15 @@ class Outputs {
         }
     }
     // With a continuum, E_total and E_balance cover both models (and the coupling's work).
-    const double total = scene_total(scene_, e);
+    const ContinuumEnergies c = continuum_energies(scene_);
+    const double total = scene_total(e, c);
     const double balance = total + e.dissipated + e.fracture - e.external_work - coupling_work(scene_) - initial_total;
     for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture, total, balance})
       row_.push_back(x);
     if (scene_.continuum) {
-      row_.push_back(scene_.continuum->kinetic_energy());
-      row_.push_back(scene_.continuum->strain_energy());
-      if (scene_.continuum->is_coupled()) row_.push_back(scene_.continuum->coupling_work());
+      row_.push_back(c.kinetic);
+      row_.push_back(c.strain);
+      if (scene_.continuum->is_coupled()) row_.push_back(coupling_work(scene_));
     }
     if (scene_.dem.failure_enabled()) {
       for (const auto& set : scene_.dem.bond_sets()) {
@@ -325,7 +332,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Outputs outputs(scene);
   Progress progress(options.show_progress, total_steps);
   RunResult result;
-  const double initial_total = scene_total(scene, model.energies());
+  const double initial_total = scene_total(model.energies(), continuum_energies(scene));
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
   // the motion that boundary conditions impose.

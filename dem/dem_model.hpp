@@ -109,9 +109,8 @@ class DemModel {
 
   // Output rows: the next step's force pass also records every bond's energy, so that
   // energies() and group_energy() after that step read it instead of evaluating every bond
-  // again (without the request they evaluate the bonds themselves). They read the record until
-  // the next step starts: code that moves DEs after a recorded step must do so before it
-  // requests the next record, not between the step and the read.
+  // again (without the request they evaluate the bonds themselves). They trust the record until
+  // the next step starts, so DEs moved between a recorded step and these calls are not seen.
   void record_energies_in_next_step() { energy_record_requested_ = true; }
   Energies energies() const;
   double kinetic_energy() const;  // Energies::kinetic alone (no bond pass), J

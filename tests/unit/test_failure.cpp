@@ -183,6 +183,17 @@ double build_breakable_model(DemModel& model, std::array<int, 3> counts) {
   return 0.5 * model.critical_time_step();
 }
 
+// Moves every DE by up to 2e-3 of `spacing` (m) along each axis and turns it by up to 2e-3 rad
+// about each axis, at random (seed 3): bonds loaded in every mode.
+void perturb(ParticleSet& p, double spacing) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.position[i] += Vec3{uni(rng), uni(rng), uni(rng)} * (2e-3 * spacing);
+    p.orientation[i] = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 2e-3);
+  }
+}
+
 // Output rows read the bonds' energies that the step's force pass recorded (on request): the
 // same bits as a bond pass of their own, also in steps where bonds break (the forces and the
 // record are then taken again without them); steps without the request evaluate the bonds.
@@ -228,12 +239,7 @@ TEST(ForceScan, RecordingLeavesTheForcesUnchanged) {
   DemModel model;
   build_breakable_model(model, {6, 5, 5});
   ParticleSet& p = model.particles;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> uni(-1.0, 1.0);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    p.position[i] += Vec3{uni(rng), uni(rng), uni(rng)} * 4e-6;  // m, 2e-3 of the spacing
-    p.orientation[i] = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 2e-3);
-  }
+  perturb(p, 2e-3);
   std::vector<Sym3> virial(p.size());
   ASSERT_EQ(model.bond_sets().size(), 2u);  // beams and springs
   for (const auto& set : model.bond_sets()) {
@@ -265,13 +271,8 @@ TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   build_lattice(model.particles, {0, 0, 0}, {16, 16, 16}, a, R, 7800.0);
   BeamBondSet& beam = test::bond_all_touching(model, {2e11, 0.3, 0.5, 1.0e9});
   model.finalize();
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> uni(-1.0, 1.0);
   ParticleSet& p = model.particles;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    p.position[i] += Vec3{uni(rng), uni(rng), uni(rng)} * (2e-3 * a);
-    p.orientation[i] = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 2e-3);
-  }
+  perturb(p, a);
   struct Pass {
     std::vector<Vec3> force, torque;
     std::vector<Sym3> virial;
