@@ -3,13 +3,6 @@
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Delaunay_triangulation_2.h>
-#include <CGAL/Delaunay_triangulation_3.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/Triangulation_vertex_base_with_info_3.h>
-#include <CGAL/natural_neighbor_coordinates_2.h>
-#include <CGAL/natural_neighbor_coordinates_3.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,19 +11,17 @@
 
 #include "common/convex_polyhedron.hpp"
 #include "common/error.hpp"
+#include "continuum/nem/natural_neighbours.hpp"
 
 namespace arlequin::continuum {
 
 namespace {
 
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using Dt3 = CGAL::Delaunay_triangulation_3<
-    Kernel, CGAL::Triangulation_data_structure_3<CGAL::Triangulation_vertex_base_with_info_3<int, Kernel>,
-                                                 CGAL::Delaunay_triangulation_cell_base_3<Kernel>>>;
-using Dt2 = CGAL::Delaunay_triangulation_2<
-    Kernel, CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<int, Kernel>,
-                                                 CGAL::Triangulation_face_base_2<Kernel>>>;
-using Coords = std::vector<std::pair<int, double>>;  // (node, shape function value)
+using nem::Coordinates;
+using nem::Coords;
+using nem::Dt2;
+using nem::Dt3;
+using nem::Kernel;
 
 Kernel::Point_3 P3(const Vec3& v) { return {v.x, v.y, v.z}; }
 
@@ -42,44 +33,10 @@ struct Plane {
   Kernel::Point_2 local(const Vec3& x) const { return {dot(x - origin, e1), dot(x - origin, e2)}; }
 };
 
-// Laplace (non-Sibsonian) coordinates in 2D: lambda_v = |Voronoi edge between p and v| / |p - v|
-// (Belikov et al. 1997; Sukumar, Moran, Semenov & Belikov, IJNME 50 (2001)). The edge joins the
-// circumcentres of (p, a, b) over the two conflict-boundary edges through v.
-bool laplace_2(const Dt2& dt, const Kernel::Point_2& p, Coords& out) {
-  Dt2::Locate_type lt;
-  int li;
-  const Dt2::Face_handle f = dt.locate(p, lt, li);
-  if (lt == Dt2::VERTEX) {
-    out.push_back({f->vertex(li)->info(), 1.0});
-    return true;
-  }
-  if (lt == Dt2::OUTSIDE_CONVEX_HULL || lt == Dt2::OUTSIDE_AFFINE_HULL) return false;
-  std::vector<Dt2::Edge> hole;
-  dt.get_boundary_of_conflicts(p, std::back_inserter(hole), f);
-  std::map<Dt2::Vertex_handle, std::vector<Kernel::Point_2>> ends;
-  for (const Dt2::Edge& e : hole) {
-    const auto a = e.first->vertex(Dt2::cw(e.second)), b = e.first->vertex(Dt2::ccw(e.second));
-    if (dt.is_infinite(a) || dt.is_infinite(b)) return false;
-    const auto cc = CGAL::circumcenter(p, a->point(), b->point());
-    ends[a].push_back(cc);
-    ends[b].push_back(cc);
-  }
-  double sum = 0;
-  const size_t first = out.size();
-  for (const auto& [v, cc] : ends) {
-    if (cc.size() != 2) return false;
-    const double w = std::sqrt(CGAL::squared_distance(cc[0], cc[1]) / CGAL::squared_distance(p, v->point()));
-    out.push_back({v->info(), w});
-    sum += w;
-  }
-  for (size_t k = first; k < out.size(); ++k) out[k].second /= sum;
-  return true;
-}
-
 }  // namespace
 
 struct NemSolver::Geometry {
-  bool laplace = false;
+  Coordinates kind = Coordinates::sibson;
   double tol = 0;  // length: "on a plane" for nodes and points
   Dt3 dt;
   std::vector<Plane> planes;
@@ -87,20 +44,7 @@ struct NemSolver::Geometry {
 
   // Natural-neighbour coordinates on domain plane k (p projected onto it).
   bool on_plane(int k, const Vec3& p, Coords& out) const {
-    out.clear();
-    const Plane& pl = planes[k];
-    const Kernel::Point_2 q = pl.local(p);
-    if (laplace) return laplace_2(pl.dt, q, out);
-    struct Info {
-      std::pair<int, double> operator()(const std::pair<Dt2::Vertex_handle, double>& vp) const {
-        return {vp.first->info(), vp.second};
-      }
-    };
-    const size_t first = out.size();
-    const auto r = CGAL::natural_neighbor_coordinates_2(pl.dt, q, std::back_inserter(out), Info());
-    if (!r.third) return false;
-    for (size_t k2 = first; k2 < out.size(); ++k2) out[k2].second /= r.second;
-    return true;
+    return nem::natural_neighbour_coordinates(planes[k].dt, planes[k].local(p), kind, out);
   }
 
   // Shape functions at any point of the closed domain; false outside it.
@@ -114,26 +58,15 @@ struct NemSolver::Geometry {
     }
     if (on.size() == 1) return on_plane(on[0], p, out);
     if (on.size() >= 2) return on_edge_or_corner(on, p, out);
-    if (!laplace && in_3d(p, false, out)) {
-      // CGAL's Sibson volumes use the circumcentre of every conflict cell; a flat cell (four
+    if (kind == Coordinates::sibson && nem::natural_neighbour_coordinates(dt, p, Coordinates::sibson, out)) {
+      // Sibson volumes use the circumcentre of every conflict cell; a flat cell (four
       // cocircular nodes on a flat boundary face, common in gmsh surface meshes) spoils them.
       // Such points are caught by the linear-reproduction check and get Laplace coordinates.
       Vec3 r{};
       for (const auto& [J, value] : out) r += value * (*x)[J];
       if (norm(r - p) <= 1e-3 * tol) return true;
     }
-    return in_3d(p, true, out);
-  }
-
-  bool in_3d(const Vec3& p, bool use_laplace, Coords& out) const {
-    out.clear();
-    std::vector<std::pair<Dt3::Vertex_handle, double>> nn;
-    double norm_coeff = 0;
-    const auto r = use_laplace ? CGAL::laplace_natural_neighbor_coordinates_3(dt, P3(p), std::back_inserter(nn), norm_coeff)
-                               : CGAL::sibson_natural_neighbor_coordinates_3(dt, P3(p), std::back_inserter(nn), norm_coeff);
-    if (!r.third) return false;
-    for (const auto& [v, c] : nn) out.push_back({v->info(), c / norm_coeff});
-    return true;
+    return nem::natural_neighbour_coordinates(dt, p, Coordinates::laplace, out);
   }
 
   // On an edge of the domain (two or more planes): the 1D linear interpolant between the
@@ -178,7 +111,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   if (settings.shape_functions != "sibson" && settings.shape_functions != "laplace")
     throw InputError("nem: shape_functions must be 'sibson' or 'laplace', got '" + settings.shape_functions + "'");
   Geometry& g = *geo_;
-  g.laplace = settings.shape_functions == "laplace";
+  g.kind = settings.shape_functions == "laplace" ? Coordinates::laplace : Coordinates::sibson;
   if (!(settings.nem_stabilization > 0.0))
     throw InputError("nem: stabilization must be > 0 (MSCNI's a; 1 integrates each sub-cell), got " +
                      std::to_string(settings.nem_stabilization));

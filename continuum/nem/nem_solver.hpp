@@ -1,8 +1,8 @@
 // NemSolver ("nem"): natural element method in the spirit of CNEM, on the nodes of the mesh.
 // - Shape functions: Sibson or Laplace natural-neighbour coordinates of the 3D Delaunay
-//   tessellation of the nodes (CGAL::Delaunay_triangulation_3 and
-//   CGAL/natural_neighbor_coordinates_3.h). They form a partition of unity, reproduce linear
-//   fields and are Kronecker-delta at the nodes. CGAL fails on the convex hull itself, so on a
+//   tessellation of the nodes (CGAL::Delaunay_triangulation_3; the coordinates are ours,
+//   natural_neighbours.hpp, summed in node order). They form a partition of unity, reproduce
+//   linear fields and are Kronecker-delta at the nodes. They are undefined on the convex hull itself, so on a
 //   flat boundary face the 2D coordinates of the face's own nodes are used (the limit of the
 //   3D ones on a convex hull), and on an edge of the domain the 1D linear interpolant.
 // - Integration: stabilised conforming nodal integration (SCNI; Chen, Wu, Yoon & You, IJNME 50
