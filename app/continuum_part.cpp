@@ -64,6 +64,7 @@ class Part final : public ContinuumPart {
       if (static_) coupling->fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
       read_coupling(*coupling);
       settings.mesh.left_out = [zone = *zone_](const Vec3& x) { return zone.in_pure_dem_zone(x); };
+      settings.mesh.left_out_name = "the pure-DEM zone of coupling.overlap (" + overlap_where_ + ": " + zone_->description() + ")";
     }
     try {
       solver_ = continuum::make_continuum_solver(name, settings);
@@ -98,7 +99,11 @@ class Part final : public ContinuumPart {
   void couple(dem::DemModel& dem) override {
     options_.held_continuum_dofs = held_dofs_;
     options_.driven_des = dem.driven_particles();
-    coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
+    try {
+      coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
+    } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses)
+      throw InputError(overlap_where_ + ": coupling.overlap: " + e.what());
+    }
   }
   void solve_static() override { solver_->solve_static(petsc_options_); }
   bool has_group(const std::string& name) const override { return solver_->mesh().has_group(name); }
@@ -169,7 +174,9 @@ class Part final : public ContinuumPart {
     weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
     weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
     weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
-    zone_ = read_overlap(section.child("overlap"), weighting);
+    CaseNode overlap = section.child("overlap");
+    overlap_where_ = overlap.where();
+    zone_ = read_overlap(overlap, weighting);
     static constexpr std::string_view mediators[] = {"coarse", "fine"};
     static constexpr std::string_view types[] = {"l2", "h1"};
     options_.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
@@ -265,6 +272,7 @@ class Part final : public ContinuumPart {
 
   std::unique_ptr<ContinuumSolver> solver_;
   std::optional<coupling::OverlapZone> zone_;  // with a coupling section
+  std::string overlap_where_;                  // "case.yaml:20", for errors about the overlap
   coupling::CoupledOptions options_;
   std::unique_ptr<coupling::CoupledModel> coupled_;
   std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)

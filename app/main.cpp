@@ -46,7 +46,7 @@ constexpr const char* usage_run =
     "usage: arlequin run CASE.yaml [--out DIR] [--set key.path=value ...] [--steps N]\n"
     "  --out DIR      write results to DIR instead of output.dir of the case\n"
     "  --set k=v      override a case value (YAML syntax), e.g. --set time.end=1e-3\n"
-    "  --steps N      stop after N steps\n"
+    "  --steps N      stop after N steps (before time.end the case's checks are not evaluated)\n"
     "  --petsc \"...\"  PETSc options for continuum solves, e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
     "  --quiet        no progress line\n"
     "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed,\n"
@@ -169,7 +169,8 @@ void print_scene_facts(const app::Scene& scene) {
                 r.fabric_eigenvalues[0], r.fabric_eigenvalues[1], r.fabric_eigenvalues[2], r.max_overlap, r.seconds);
   }
   for (const auto& set : model.bond_sets())
-    std::printf("  %s bonds (%s): %zu\n", set->name.c_str(), std::string(set->law()).c_str(), set->size());
+    std::printf("  %s (%s): %zu\n", set->name == "bonds" ? "bonds" : (set->name + " bonds").c_str(), std::string(set->law()).c_str(),
+                set->size());
   if (model.particles.size() > 0)
     std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
   if (scene.continuum) {
@@ -182,7 +183,7 @@ void print_scene_facts(const app::Scene& scene) {
   }
   std::printf("  critical time step: %.6e s\n  time step: %.6e s (%.3f of critical)\n  steps: %ld to t = %.6e s\n",
               scene.dt_critical, scene.dt, scene.dt / scene.dt_critical,
-              static_cast<long>(std::ceil(scene.end_time / scene.dt - 1e-9)), scene.end_time);
+              scene.steps, scene.end_time);
 }
 
 int run(const Arguments& a) {
@@ -209,6 +210,7 @@ int run(const Arguments& a) {
                   app::describe(c.check->kind), c.value, c.check->expected, 100 * c.relative_error,
                   100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
   }
+  if (!r.checks_skipped.empty()) std::printf("checks not evaluated: %s\n", r.checks_skipped.c_str());
   std::printf("results: %s\n", std::filesystem::absolute(scene.output.dir).string().c_str());
   return r.all_checks_passed() ? 0 : 5;
 }

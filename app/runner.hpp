@@ -41,6 +41,7 @@ struct RunResult {
     bool passed;
   };
   std::vector<CheckResult> checks;
+  std::string checks_skipped;   // why the checks were not evaluated (empty: they were)
   bool all_checks_passed() const {
     return std::all_of(checks.begin(), checks.end(), [](const CheckResult& c) { return c.passed; });
   }

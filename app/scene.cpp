@@ -1,7 +1,11 @@
 #include "app/scene.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <limits>
@@ -497,13 +501,35 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
   }
 }
 
-void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& options) {
+// The output folder (--out, else output.dir, else results/<name>), checked now, so that one that
+// cannot be written is bad input before any work. Nothing is created here (`check` writes
+// nothing); the run creates it.
+std::filesystem::path prepare_output_dir(std::optional<CaseNode> out, const std::string& name, const SceneOptions& options) {
+  std::filesystem::path dir = out ? out->string_or("dir", "results/" + name) : "results/" + name;
+  if (!options.out_dir.empty()) dir = options.out_dir;
+  // The folder itself, or the nearest of its parents that exists, must be a writable folder.
+  std::error_code ec;
+  std::filesystem::path existing = std::filesystem::absolute(dir, ec);
+  while (!std::filesystem::exists(existing, ec) && existing.has_parent_path() && existing != existing.parent_path())
+    existing = existing.parent_path();
+  std::string problem;
+  if (!std::filesystem::is_directory(existing, ec))
+    problem = "'" + existing.string() + "' is not a folder";
+  else if (access(existing.c_str(), W_OK) != 0)
+    problem = "'" + existing.string() + "' is not writable (" + std::strerror(errno) + ")";
+  if (!problem.empty()) {
+    const std::string message = "cannot write the outputs to '" + dir.string() + "': " + problem;
+    if (options.out_dir.empty() && out && out->has("dir")) out->fail("dir", message);
+    throw InputError((options.out_dir.empty() ? "output folder" : "--out") + std::string(": ") + message);
+  }
+  return dir;
+}
+
+void read_output(std::optional<CaseNode> out, Scene& scene) {
   static constexpr std::string_view field_kinds[] = {"particles", "bonds", "continuum"};
   OutputPlan& plan = scene.output;
-  plan.dir = "results/" + scene.name;
   plan.every = scene.end_time / 100.0;
   if (out) {
-    plan.dir = out->string_or("dir", plan.dir.string());
     plan.every = out->number_or("every", plan.every, Range::positive(), "s");
     for (const std::string& f : out->strings_or("fields", {})) {
       if (std::find(std::begin(field_kinds), std::end(field_kinds), f) == std::end(field_kinds))
@@ -531,7 +557,6 @@ void read_output(std::optional<CaseNode> out, Scene& scene, const SceneOptions& 
     }
     out->finish();
   }
-  if (!options.out_dir.empty()) plan.dir = options.out_dir;
 }
 
 }  // namespace
@@ -556,6 +581,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   scene.name = root.string_or("name", case_file.parent_path().filename().string());
   static constexpr std::string_view unit_systems[] = {"SI"};
   root.choice_or("units", "SI", unit_systems);
+  scene.output.dir = prepare_output_dir(root.child_if("output"), scene.name, options);
 
   // The models first: the time section's defaults depend on them.
   std::optional<CaseNode> dem_node = root.child_if("dem");
@@ -615,6 +641,14 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (scene.continuum)
     scene.dt_critical = scene.continuum->is_coupled() ? scene.continuum->critical_time_step()
                                                        : std::min(scene.dt_critical, scene.continuum->critical_time_step());
+  // A zero or NaN limit (a stiffness overflowing to inf, a zero mass) would give dt = 0 and a
+  // run of no steps, or NaN everywhere.
+  if (!static_only && !(scene.dt_critical > 0.0)) {
+    std::ostringstream msg;
+    msg << "the critical time step is " << scene.dt_critical
+        << " s: a stiffness or a mass of the scene is out of range (check the moduli, densities and radii)";
+    throw InputError(root.where() + ": " + msg.str());
+  }
   if (static_only) {
     scene.dt = scene.end_time;  // one static solve
   } else if (user_dt) {
@@ -630,7 +664,18 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       time->fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
     scene.dt = scene.safety * scene.dt_critical;
   }
-  read_output(root.child_if("output"), scene, options);
+  const double steps = std::ceil(scene.end_time / scene.dt - 1e-9);
+  if (!(steps >= 1.0) || steps > 1e15) {
+    std::ostringstream msg;
+    if (steps >= 1.0)
+      msg << "time.end / dt = " << steps << " steps (time.end " << scene.end_time << " s, dt " << scene.dt
+          << " s): more than 1e15; raise dt or lower time.end";
+    else
+      msg << "time.end = " << scene.end_time << " s is shorter than one time step (dt = " << scene.dt << " s)";
+    time->fail("end", msg.str());
+  }
+  scene.steps = static_cast<long>(steps);
+  read_output(root.child_if("output"), scene);
   std::vector<std::string> columns = sensor_columns(scene);
   columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_fracture", "E_total"});
   read_checks(root, scene, columns);

@@ -101,6 +101,7 @@ struct Scene {
   double dt = 0.0;            // s
   double dt_critical = 0.0;   // s
   double safety = 0.3;
+  long steps = 0;             // to reach end_time: ceil(end_time / dt), at least 1
   std::vector<Sensor> sensors;
   std::vector<Check> checks;
   OutputPlan output;

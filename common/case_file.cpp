@@ -336,7 +336,16 @@ void CaseNode::fail(std::string_view key, std::string_view message) const {
 }
 
 void CaseNode::missing(std::string_view key, std::string_view expected) const {
-  raise(where(), path_, "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")");
+  std::string message = "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")";
+  // A misspelling of it is the likely cause: name the key not read so far that is closest.
+  const std::string_view wanted[] = {key};
+  for (const auto& present : keys())
+    if (!recognised(present) && closest_match(present, wanted)) {
+      const Entry e = find(present);
+      message += "; is '" + present + "' (" + (e.line > 0 ? "line " + std::to_string(e.line) : where(e)) + ") a misspelling of it?";
+      break;
+    }
+  raise(where(), path_, message);
 }
 
 void CaseNode::mismatch(const Entry& e, std::string_view expected) const {
@@ -621,14 +630,17 @@ std::vector<std::string> CaseNode::keys() const {
 
 void CaseNode::accept_any_keys() { record_->any_keys = true; }
 
+bool CaseNode::recognised(std::string_view key) const {
+  const auto& known = record_->known;
+  const auto& named = record_->named;
+  return std::find(known.begin(), known.end(), key) != known.end() || std::find(named.begin(), named.end(), key) != named.end();
+}
+
 void CaseNode::finish() const {
   if (record_->any_keys) return;
   const auto& known = record_->known;
-  const auto& named = record_->named;
   for (const auto& key : keys()) {
-    if (std::find(known.begin(), known.end(), key) != known.end() ||
-        std::find(named.begin(), named.end(), key) != named.end())
-      continue;
+    if (recognised(key)) continue;
     const std::vector<std::string_view> valid(known.begin(), known.end());
     const auto hint = closest_match(key, valid);
     raise(where(find(key)), key_path(key),

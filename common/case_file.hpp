@@ -118,6 +118,7 @@ class CaseNode {
   double to_number(const Entry& e, Range range, std::string_view unit, bool integer) const;
   std::string to_string(const Entry& e) const;
   std::string where(const Entry& e) const;
+  bool recognised(std::string_view key) const;  // asked for by an accessor so far
   [[noreturn]] void missing(std::string_view key, std::string_view expected) const;
   [[noreturn]] void mismatch(const Entry& e, std::string_view expected) const;
 

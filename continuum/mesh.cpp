@@ -210,7 +210,7 @@ Mesh Mesh::load(const MeshSource& source) {
   int dropped = 0;
   if (source.left_out) {
     dropped = leave_out(npe, source.left_out, nodes, tets, groups);
-    if (tets.empty()) throw InputError(source.path + ": every tetrahedron lies in the left-out region (the pure-DEM zone)");
+    if (tets.empty()) throw InputError(source.path + ": every tetrahedron lies in " + source.left_out_name);
   }
   Mesh mesh(order, std::move(nodes), std::move(tets), std::move(groups));
   mesh.tets_left_out_ = dropped;

@@ -25,6 +25,7 @@ struct MeshSource {
   double size = 0.0;  // target element size for .geo; 0 keeps the sizes written in the file
   int order = 1;      // 1 or 2, for .geo
   std::function<bool(const Vec3&)> left_out;  // optional: see the contract
+  std::string left_out_name = "the left-out region";  // for the error when it holds everything
 };
 
 // Edge k of a tetrahedron joins vertices kTetEdges[k]; node 4+k of a P2 tetrahedron sits on it.

@@ -70,6 +70,45 @@ TEST(Cases, DemoBeamImpactConservesEnergyAndWritesFields) {
   EXPECT_GT(s.at("counts").at("neighbour_rebuilds").as_integer(), 0);
 }
 
+// The checks are stated for the whole case: a run cut short by --steps is not judged (it
+// would fail them), and says so.
+TEST(Cases, ChecksAreNotJudgedOnARunCutShortBySteps) {
+  const auto out = test::scratch_dir("cut_short");
+  const auto r = test::run_arlequin("run " + cases + "wave_bar_dem/case.yaml --quiet --steps 5 --out " + out.string(), "stdout");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("checks not evaluated: the run stopped at step 5 of "), std::string::npos) << r.output;
+  const Json s = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_TRUE(s.at("checks").as_array().empty());
+  EXPECT_NE(s.at("checks_skipped").as_string().find("--steps"), std::string::npos);
+}
+
+// --out must name a folder that can be written: refused before the run, as bad input.
+TEST(BadInput, OutputFolderThatIsAFile) {
+  const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --quiet --out /dev/null/x");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--out: cannot write the outputs to '/dev/null/x': '/dev/null' is not a folder"), std::string::npos)
+      << r.output;
+}
+
+// An overlap that misses the mesh or the DEs is reported at the overlap's line.
+TEST(BadInput, OverlapMissingTheModelsNamesTheOverlap) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const std::string check = "check " + cases + "wave_bar_coupled/case.yaml --set coupling.overlap.box=";
+  const auto beyond_mesh = test::run_arlequin(check + "[[5,5,5],[6,6,6]]");
+  EXPECT_EQ(beyond_mesh.exit_code, 2) << beyond_mesh.output;
+  EXPECT_NE(beyond_mesh.output.find("every tetrahedron lies in the pure-DEM zone of coupling.overlap (" + cases +
+                                    "wave_bar_coupled/case.yaml:27: box (5, 5, 5)-(6, 6, 6)"),
+            std::string::npos)
+      << beyond_mesh.output;
+  const auto no_de = test::run_arlequin(check + "[[0.044,0.02,-0.001],[0.060,0.03,0.009]]");
+  EXPECT_EQ(no_de.exit_code, 2) << no_de.output;
+  EXPECT_NE(no_de.output.find("wave_bar_coupled/case.yaml:27: coupling.overlap: coupling: no DE lies in the overlap"),
+            std::string::npos)
+      << no_de.output;
+}
+
 TEST(Cases, BondedBlockShortRunBalancesEnergyWithoutContactSearch) {
   const Json s = run_case("bonded_block_tension", "--steps 50");
   EXPECT_EQ(s.at("steps").as_integer(), 50);

@@ -181,6 +181,15 @@ TEST_F(CaseFileTest, MissingRequiredKeyNamesParentAndKey) {
   EXPECT_CONTAINS(error_of([&] { c.root().child("time"); }), "case.yaml:1: missing required key 'time'");
 }
 
+TEST_F(CaseFileTest, MissingRequiredKeyPointsAtItsMisspelling) {
+  CaseFile c = load("bond:\n  E_m: 1e9\n  r_mu: 0.3\n");
+  CaseNode bond = c.root().child("bond");
+  bond.number("r_mu", Range::positive(), "1");
+  EXPECT_CONTAINS(error_of([&] { bond.number("E_mu", Range::positive(), "Pa"); }),
+                  "case.yaml:1: bond: missing required key 'E_mu' (a number > 0 [Pa]); is 'E_m' (line 2) a "
+                  "misspelling of it?");
+}
+
 TEST_F(CaseFileTest, MissingFile) {
   EXPECT_CONTAINS(error_of([&] { CaseFile::load(dir_ / "nope.yaml"); }),
                   "nope.yaml: cannot open case file (No such file or directory)");
