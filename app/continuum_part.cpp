@@ -102,7 +102,9 @@ class Part final : public ContinuumPart {
     try {
       coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
     } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses)
-      throw InputError(overlap_where_ + ": coupling.overlap: " + e.what());
+      std::string_view what = e.what();
+      if (what.starts_with("coupling: ")) what.remove_prefix(10);
+      throw InputError(overlap_where_ + ": coupling.overlap: " + std::string(what));
     }
   }
   void solve_static() override { solver_->solve_static(petsc_options_); }

@@ -280,7 +280,9 @@ int calibrate(const Arguments& a) {
 }
 
 int check(const Arguments& a) {
-  app::Scene scene = app::build_scene(a.case_file, a.scene);
+  app::SceneOptions options = a.scene;
+  options.check_output_dir = false;  // validating a case writes nothing, so may run where nothing can be written
+  app::Scene scene = app::build_scene(a.case_file, options);
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
   print_scene_facts(scene);
   return 0;

@@ -329,6 +329,8 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
 RunResult run_scene(Scene& scene, const RunOptions& options) {
   dem::DemModel& model = scene.dem;
   long total_steps = scene.steps;
+  // A static continuum alone: one solve, whatever --steps says.
+  const bool static_only = scene.continuum && scene.continuum->is_static() && model.particles.size() == 0;
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
   Outputs outputs(scene);
@@ -370,7 +372,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
                                    ", t = " + std::to_string(current_time()) + " s; the outputs so far are closed and kept");
   };
   try {
-    if (scene.continuum && scene.continuum->is_static() && model.particles.size() == 0) {
+    if (static_only) {
       scene.continuum->solve_static();  // a static continuum alone: one solve, one output
       total_steps = 0;
     }
@@ -434,7 +436,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   wall["steps_per_second"] = result.steps / std::max(result.wall_seconds - output_seconds, 1e-9);
   summary["energies"] = energies_json(result.energies);
   // The checks are stated for the whole case: a run cut short by --steps is not judged.
-  if (failure.empty() && !scene.checks.empty() && options.max_steps >= 0 && options.max_steps < scene.steps)
+  if (failure.empty() && !scene.checks.empty() && !static_only && options.max_steps >= 0 && options.max_steps < scene.steps)
     result.checks_skipped = "the run stopped at step " + std::to_string(result.steps) + " of " + std::to_string(scene.steps) +
                             " (--steps), before time.end";
   else if (failure.empty())

@@ -501,21 +501,31 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
   }
 }
 
-// The output folder (--out, else output.dir, else results/<name>), checked now, so that one that
-// cannot be written is bad input before any work. Nothing is created here (`check` writes
-// nothing); the run creates it.
+// The output folder (--out, else output.dir, else results/<name>), checked now (unless
+// options.check_output_dir is off, as for `check`), so that one that cannot be written is bad
+// input before any work. Nothing is created here; the run creates it.
 std::filesystem::path prepare_output_dir(std::optional<CaseNode> out, const std::string& name, const SceneOptions& options) {
   std::filesystem::path dir = out ? out->string_or("dir", "results/" + name) : "results/" + name;
   if (!options.out_dir.empty()) dir = options.out_dir;
-  // The folder itself, or the nearest of its parents that exists, must be a writable folder.
+  if (!options.check_output_dir) return dir;
+  // The folder itself, or the nearest of its parents that exists, must be a folder we may write
+  // in and enter; a parent we may not look into is a problem of its own.
+  std::string problem;
   std::error_code ec;
   std::filesystem::path existing = std::filesystem::absolute(dir, ec);
-  while (!std::filesystem::exists(existing, ec) && existing.has_parent_path() && existing != existing.parent_path())
+  for (;;) {
+    const auto status = std::filesystem::status(existing, ec);
+    if (std::filesystem::exists(status)) break;
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+      problem = "'" + existing.string() + "': " + ec.message();
+      break;
+    }
+    if (!existing.has_parent_path() || existing == existing.parent_path()) break;
     existing = existing.parent_path();
-  std::string problem;
-  if (!std::filesystem::is_directory(existing, ec))
+  }
+  if (problem.empty() && !std::filesystem::is_directory(existing, ec))
     problem = "'" + existing.string() + "' is not a folder";
-  else if (access(existing.c_str(), W_OK) != 0)
+  else if (problem.empty() && access(existing.c_str(), W_OK | X_OK) != 0)
     problem = "'" + existing.string() + "' is not writable (" + std::strerror(errno) + ")";
   if (!problem.empty()) {
     const std::string message = "cannot write the outputs to '" + dir.string() + "': " + problem;
@@ -671,7 +681,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       msg << "time.end / dt = " << steps << " steps (time.end " << scene.end_time << " s, dt " << scene.dt
           << " s): more than 1e15; raise dt or lower time.end";
     else
-      msg << "time.end = " << scene.end_time << " s is shorter than one time step (dt = " << scene.dt << " s)";
+      msg << "time.end = " << scene.end_time << " s is not even 1e-9 of a time step (dt = " << scene.dt << " s): no step would run";
     time->fail("end", msg.str());
   }
   scene.steps = static_cast<long>(steps);

@@ -112,6 +112,7 @@ struct SceneOptions {
   std::filesystem::path out_dir;       // --out, empty = from the case
   std::string petsc_options;           // --petsc "...", after the case's own
   bool rebuild_sample = false;         // build the packing even if its cache file matches
+  bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
 };
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).

@@ -275,6 +275,37 @@ std::optional<std::string_view> closest_match(std::string_view word,
   return best;
 }
 
+namespace {
+
+// True when `typed` is `meant` with one character dropped, one added, two neighbours swapped, or
+// only the letter case changed: the slips that make a key. A missing key is only compared with
+// such near misses, as any other present key may be a valid one not read yet (r_mu is one
+// substitution from E_mu).
+bool is_slip_of(std::string_view typed, std::string_view meant) {
+  const auto lower = [](std::string_view s) {
+    std::string out(s);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+  };
+  if (typed == meant) return false;
+  if (lower(typed) == lower(meant)) return true;
+  if (typed.size() + 1 == meant.size() || meant.size() + 1 == typed.size()) {
+    const std::string_view longer = typed.size() > meant.size() ? typed : meant, shorter = typed.size() > meant.size() ? meant : typed;
+    for (std::size_t k = 0; k < longer.size(); ++k)
+      if (std::string(longer.substr(0, k)) + std::string(longer.substr(k + 1)) == shorter) return true;
+    return false;
+  }
+  if (typed.size() != meant.size()) return false;
+  for (std::size_t k = 0; k + 1 < typed.size(); ++k) {
+    std::string swapped(typed);
+    std::swap(swapped[k], swapped[k + 1]);
+    if (swapped == meant) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 // ---- CaseNode ------------------------------------------------------------------------
 
 struct CaseNode::Entry {
@@ -337,10 +368,9 @@ void CaseNode::fail(std::string_view key, std::string_view message) const {
 
 void CaseNode::missing(std::string_view key, std::string_view expected) const {
   std::string message = "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")";
-  // A misspelling of it is the likely cause: name the key not read so far that is closest.
-  const std::string_view wanted[] = {key};
+  // A slip of the pen is the likely cause: name a key not read so far that is one.
   for (const auto& present : keys())
-    if (!recognised(present) && closest_match(present, wanted)) {
+    if (!recognised(present) && is_slip_of(present, key)) {
       const Entry e = find(present);
       message += "; is '" + present + "' (" + (e.line > 0 ? "line " + std::to_string(e.line) : where(e)) + ") a misspelling of it?";
       break;

@@ -63,6 +63,8 @@ class NemSolver : public ContinuumSolver {
   ~NemSolver() override;
   static std::unique_ptr<ContinuumSolver> create(const ContinuumSettings& settings);
 
+  // Const, but not to be called from two threads at once on one solver: a query marks the cells
+  // of its triangulation (natural_neighbours.hpp).
   InterpolationOperator interpolation(const std::vector<Vec3>& points) const override;
   // Clipped Voronoi cell volumes |V_i| (their sum is the domain volume).
   const std::vector<double>& cell_volumes() const { return cell_volume_; }

@@ -50,12 +50,25 @@ std::vector<int> identity(size_t n) {
   return order;
 }
 
+// Random points inside the cube, and points of the grid's degenerate places (on its planes and
+// lines between nodes, where Delaunay facets and edges lie, and at cell centres, where eight
+// nodes are cospherical): those exercise the symbolic perturbation of the conflict tests.
 std::vector<Vec3> queries(unsigned seed, int count) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> uni(0.02, 0.98);
   std::vector<Vec3> q;
   for (int i = 0; i < count; ++i) q.push_back({uni(rng), uni(rng), uni(rng)});
+  for (const Vec3& special : {Vec3{0.25, 0.3, 0.4}, Vec3{0.5, 0.5, 0.37}, Vec3{0.375, 0.375, 0.375}, Vec3{0.625, 0.125, 0.875},
+                              Vec3{0.5, 0.375, 0.625}, Vec3{0.3125, 0.3125, 0.25}})
+    q.push_back(special);
   return q;
+}
+
+// Every cell's scratch index is back to "outside" after a query.
+bool all_cells_unmarked(const Dt3& dt) {
+  for (auto c = dt.all_cells_begin(); c != dt.all_cells_end(); ++c)
+    if (c->info().index != -1) return false;
+  return true;
 }
 
 std::map<int, double> cgal_3d(const Dt3& dt, const Vec3& q, Coordinates kind) {
@@ -103,10 +116,14 @@ TEST(NaturalNeighbours, ThreeDMatchCgal) {
         expect_same_values(phi, cgal_3d(dt, q, kind), what);
         expect_linear_reproduction(phi, x, q, what);
       }
+      EXPECT_TRUE(all_cells_unmarked(dt)) << what;
       ASSERT_TRUE(natural_neighbour_coordinates(dt, x[17], kind, phi));  // at a node: its own function only
       ASSERT_EQ(phi.size(), 1u);
       EXPECT_EQ(phi[0].first, 17);
       EXPECT_FALSE(natural_neighbour_coordinates(dt, Vec3{1.5, 0.5, 0.5}, kind, phi)) << "outside the hull";
+      EXPECT_FALSE(natural_neighbour_coordinates(dt, Vec3{1.0, 0.3, 0.6}, kind, phi)) << "on a hull face";
+      EXPECT_FALSE(natural_neighbour_coordinates(dt, Vec3{1.0, 0.0, 0.6}, kind, phi)) << "on a hull edge";
+      EXPECT_TRUE(all_cells_unmarked(dt)) << what;
     }
   }
 }

@@ -80,14 +80,28 @@ TEST(Cases, ChecksAreNotJudgedOnARunCutShortBySteps) {
   const Json s = Json::parse(test::read_text(out / "summary.json"));
   EXPECT_TRUE(s.at("checks").as_array().empty());
   EXPECT_NE(s.at("checks_skipped").as_string().find("--steps"), std::string::npos);
+#ifdef ARLEQUIN_WITH_CONTINUUM
+  // A static case is one solve whatever --steps says: its checks are judged.
+  const Json solved = run_case("cantilever_continuum", "--steps 0");
+  EXPECT_TRUE(solved.at("checks").as_array().at(0).at("passed").as_bool());
+  EXPECT_EQ(solved.find("checks_skipped"), nullptr);
+#endif
 }
 
-// --out must name a folder that can be written: refused before the run, as bad input.
+// --out must name a folder that can be written: refused before the run, as bad input. `check`
+// writes nothing and does not judge it.
 TEST(BadInput, OutputFolderThatIsAFile) {
   const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --quiet --out /dev/null/x");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--out: cannot write the outputs to '/dev/null/x': '/dev/null' is not a folder"), std::string::npos)
       << r.output;
+  const auto from_case = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --quiet --set output.dir=/dev/null/x");
+  EXPECT_EQ(from_case.exit_code, 2) << from_case.output;
+  EXPECT_NE(from_case.output.find("--set output.dir=/dev/null/x: output.dir: cannot write the outputs to '/dev/null/x'"),
+            std::string::npos)
+      << from_case.output;
+  const auto checked = test::run_arlequin("check " + cases + "cantilever_chain/case.yaml --set output.dir=/dev/null/x", "stdout");
+  EXPECT_EQ(checked.exit_code, 0) << checked.output;
 }
 
 // An overlap that misses the mesh or the DEs is reported at the overlap's line.
@@ -104,7 +118,7 @@ TEST(BadInput, OverlapMissingTheModelsNamesTheOverlap) {
       << beyond_mesh.output;
   const auto no_de = test::run_arlequin(check + "[[0.044,0.02,-0.001],[0.060,0.03,0.009]]");
   EXPECT_EQ(no_de.exit_code, 2) << no_de.output;
-  EXPECT_NE(no_de.output.find("wave_bar_coupled/case.yaml:27: coupling.overlap: coupling: no DE lies in the overlap"),
+  EXPECT_NE(no_de.output.find("wave_bar_coupled/case.yaml:27: coupling.overlap: no DE lies in the overlap"),
             std::string::npos)
       << no_de.output;
 }
