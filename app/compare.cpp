@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,12 +37,26 @@ struct Run {
   }
 };
 
-Run execute(const std::filesystem::path& case_file, SceneOptions options, const std::filesystem::path& out) {
+// A scene built and waiting for its run. Both scenes of a comparison are built first, so that a
+// bad second case or two cases without a common sensor are found before any run.
+struct Prepared {
+  std::unique_ptr<Scene> scene;  // in place: a coupling holds references into its scene
+  double setup_seconds = 0.0;
+};
+
+Prepared prepare(const std::filesystem::path& case_file, SceneOptions options, const std::filesystem::path& out) {
   options.out_dir = out;
   const auto t0 = std::chrono::steady_clock::now();
-  Scene scene = build_scene(case_file, options);
+  Prepared p;
+  p.scene.reset(new Scene(build_scene(case_file, options)));  // direct initialisation: no move
+  p.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return p;
+}
+
+Run execute(Prepared& prepared, const std::filesystem::path& out) {
+  Scene& scene = *prepared.scene;
   RunOptions run_options;
-  run_options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  run_options.setup_seconds = prepared.setup_seconds;
   Run run;
   run.name = scene.name;
   run.sensors = sensor_columns(scene);
@@ -107,14 +122,22 @@ Json describe_run(const Run& r) {
 
 bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                  const SceneOptions& base, const std::filesystem::path& out_dir) {
-  const Run a = execute(reference_case, base, out_dir / "reference");
-  const Run b = execute(other_case, base, out_dir / "other");
+  std::error_code ec;
+  if (std::filesystem::equivalent(reference_case, other_case, ec))
+    std::fprintf(stderr, "arlequin compare: warning: both runs are %s; the differences are run-to-run noise\n",
+                 reference_case.string().c_str());
+  Prepared prepared_a = prepare(reference_case, base, out_dir / "reference");
+  Prepared prepared_b = prepare(other_case, base, out_dir / "other");
   // Shared sensor columns (the energy totals mean different things for a DEM and a coupled run).
+  const std::vector<std::string> sensors_a = sensor_columns(*prepared_a.scene), sensors_b = sensor_columns(*prepared_b.scene);
   std::vector<std::string> shared;
-  for (const std::string& name : a.sensors)
-    if (std::find(b.sensors.begin(), b.sensors.end(), name) != b.sensors.end()) shared.push_back(name);
+  for (const std::string& name : sensors_a)
+    if (std::find(sensors_b.begin(), sensors_b.end(), name) != sensors_b.end()) shared.push_back(name);
   if (shared.empty())
     throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
+  const Run a = execute(prepared_a, out_dir / "reference");
+  prepared_a.scene.reset();  // the first run's memory, before the second run
+  const Run b = execute(prepared_b, out_dir / "other");
 
   const auto ta = a.column("time"), tb = b.column("time");
   Json sensors = Json::array();

@@ -57,6 +57,11 @@ constexpr const char* usage_check =
     "  prints the case as resolved (with defaults), the DE and bond counts, the critical\n"
     "  time step and the time step that a run would use\n";
 
+constexpr const char* usage_build_sample =
+    "usage: arlequin build-sample CASE.yaml [--set key.path=value ...]\n"
+    "  builds the random dense packing of a case whose dem.sample.build is packing (even when its\n"
+    "  cache file matches), stores it in the cache file and prints its report and radius histogram\n";
+
 constexpr const char* usage_compare =
     "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--set k=v ...]\n"
     "  runs both cases (results in DIR/reference and DIR/other, default results/compare), then for\n"
@@ -228,6 +233,7 @@ int sweep(const Arguments& a) {
 int build_sample(const Arguments& a) {
   app::SceneOptions options = a.scene;
   options.rebuild_sample = true;
+  options.check_output_dir = false;  // writes the sample's cache file only
   app::Scene scene = app::build_scene(a.case_file, options);
   if (!scene.sample) throw InputError(a.case_file + ": dem.sample.build is not packing: there is no sample to build");
   print_scene_facts(scene);
@@ -301,6 +307,7 @@ int main(int argc, char** argv) {
                  : a.command == "virtual-test" ? usage_virtual_test
                  : a.command == "calibrate" ? usage_calibrate
                  : a.command == "compare" ? usage_compare
+                 : a.command == "build-sample" ? usage_build_sample
                                         : usage_main,
                  stdout);
       return 0;

@@ -33,6 +33,7 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   }
   if (depth != 0) throw InputError("--over " + text + ": unbalanced '['");
   if (!value.empty()) axis.values.push_back(value);
+  if (axis.values.empty()) throw InputError("--over " + text + ": no values after '='");
   return axis;
 }
 

@@ -799,18 +799,34 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   std::vector<SampleVariant> samples;
   for (CaseNode s : root.list_or_empty("samples")) {
     samples.push_back({s.string("name"), s.strings_or("set", {})});
+    // Each sample's results go in a folder of its name.
+    if (samples.back().name.empty() || samples.back().name.find_first_of("/\\ ,") != std::string::npos)
+      s.fail("name", "expected a non-empty name without spaces, commas or slashes");
+    for (std::size_t k = 0; k + 1 < samples.size(); ++k)
+      if (samples[k].name == samples.back().name) s.fail("name", "sample '" + samples.back().name + "' is defined twice");
     s.finish();
   }
   if (samples.empty()) samples.push_back({"base", {}});
+  std::vector<std::string_view> sample_names;
+  std::string listed;
+  for (const SampleVariant& s : samples) {
+    sample_names.push_back(s.name);
+    listed += (listed.empty() ? "" : ", ") + s.name;
+  }
   for (const auto& name : only_samples)
-    if (std::none_of(samples.begin(), samples.end(), [&](const SampleVariant& s) { return s.name == name; }))
-      throw InputError(spec_file.string() + ": no sample named '" + name + "'");
+    if (std::find(sample_names.begin(), sample_names.end(), name) == sample_names.end()) {
+      const auto guess = closest_match(name, sample_names);
+      throw InputError(spec_file.string() + ": --sample " + name + ": no sample of that name" +
+                       (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; samples: " + listed));
+    }
   const QuasiStatic plan = QuasiStatic::read(root.child_if("quasi_static"));
   const std::optional<CaseNode> failure_node = root.child_if("failure");
   std::vector<LoadCase> tests;
   std::vector<std::optional<FailureReference>> references;
   for (CaseNode t : root.list("tests")) {
     tests.push_back(LoadCase::read(t));
+    for (std::size_t k = 0; k + 1 < tests.size(); ++k)  // each test's results go in a folder of its name
+      if (tests[k].name == tests.back().name) t.fail("name", "test '" + tests.back().name + "' is defined twice");
     if (failure_node) {
       if (tests.back().shear()) t.fail("shear", "a test to failure (failure section) is a tension test");
       references.push_back(FailureReference::read(t.child_if("reference")));

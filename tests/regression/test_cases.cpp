@@ -88,6 +88,25 @@ TEST(Cases, ChecksAreNotJudgedOnARunCutShortBySteps) {
 #endif
 }
 
+// compare builds both scenes before it runs either: a bad second case, or two cases with no
+// sensor in common, cost no run. sweep refuses an axis without values.
+TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
+  const auto out = test::scratch_dir("compare_bad");
+  auto r = test::run_arlequin("compare " + cases + "cantilever_chain/case.yaml " + cases + "wave_bar_dem/case.yaml --out " +
+                              out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("shares no sensor column with"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "reference" / "series.csv"));
+  r = test::run_arlequin("compare " + cases + "cantilever_chain/case.yaml " + (out / "missing.yaml").string() + " --out " +
+                         out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("missing.yaml: cannot open case file"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out / "reference" / "series.csv"));
+  r = test::run_arlequin("sweep " + cases + "cantilever_chain/case.yaml --over dem.damping=,,");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--over dem.damping=,,: no values after '='"), std::string::npos) << r.output;
+}
+
 // --out must name a folder that can be written: refused before the run, as bad input. `check`
 // writes nothing and does not judge it.
 TEST(BadInput, OutputFolderThatIsAFile) {

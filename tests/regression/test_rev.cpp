@@ -256,6 +256,26 @@ TEST(VirtualTests, CompositeSpecNeedsItsFourTests) {
   EXPECT_NE(r.output.find("a composite suite needs a test named TT"), std::string::npos) << r.output;
 }
 
+// Each test and sample writes into a folder of its name: two of one name are refused, and an
+// unknown --sample gets the closest name.
+TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
+  const auto dir = test::scratch_dir("virtual_tests_names");
+  homogeneous_case(dir);
+  const std::string run = "virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string();
+  write(dir / "spec.yaml", "case: sample.yaml\ntests: [{name: L, tension: z}, {name: L, tension: x}]\n");
+  auto r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("spec.yaml:2: tests[1].name: test 'L' is defined twice"), std::string::npos) << r.output;
+  write(dir / "spec.yaml", "case: sample.yaml\nsamples: [{name: a}, {name: a}]\ntests: [{name: L, tension: z}]\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("samples[1].name: sample 'a' is defined twice"), std::string::npos) << r.output;
+  write(dir / "spec.yaml", "case: sample.yaml\nsamples: [{name: dense}]\ntests: [{name: L, tension: z}]\n");
+  r = test::run_arlequin(run + " --sample dens");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--sample dens: no sample of that name; did you mean 'dense'?"), std::string::npos) << r.output;
+}
+
 // The REV of cases/rev_elastic reduced to ~2.4k DEs (mean radius 75 um: the matrix between the
 // fibre and a face is about one DE thick), all four tests through the command line. Looser
 // bounds than R3's (which need >= 40k DEs): E_L within 15 % of the rule of mixtures, nu_LT
