@@ -140,6 +140,23 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
       std::printf("%s\n", format_row(rows[printed], check_names.size()).first.c_str());
     std::fflush(stdout);
   };
+  // sweep.csv and sweep.png from the rows so far: at the end, and when a later run's input is bad
+  // (its error ends the sweep, the finished rows stay).
+  const auto write_table = [&] {
+    std::string csv = format_header(axes, check_names).second + "\n";
+    std::vector<std::vector<std::string>> picked;
+    std::vector<double> first_value, wall;
+    for (const SweepRow& row : rows) {
+      csv += format_row(row, check_names.size()).second + "\n";
+      if (!row.checks.empty()) {
+        picked.push_back(row.picked);
+        first_value.push_back(row.checks[0].first);
+        wall.push_back(row.wall);
+      }
+    }
+    write_file_atomically(out_dir / "sweep.csv", csv);
+    if (!picked.empty()) plot_sweep(out_dir / "sweep.png", axes, picked, first_value, wall, check_names[0]);
+  };
   bool all_ok = true;
   for (std::size_t run = 0; run < runs; ++run) {
     // Mixed-radix digits of `run` pick one value per axis.
@@ -171,26 +188,16 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
       row.status = r.all_checks_passed() ? "ok" : "check failed";
     } catch (const RunError& e) {
       std::fprintf(stderr, "arlequin sweep: run %zu (%s): %s\n", run, options.out_dir.string().c_str(), e.what());
+    } catch (const InputError&) {
+      if (!rows.empty()) write_table();
+      throw;
     }
     all_ok = all_ok && row.status == "ok";
     rows.push_back(std::move(row));
     print_rows(false);
   }
   print_rows(true);
-
-  std::string csv = format_header(axes, check_names).second + "\n";
-  std::vector<std::vector<std::string>> picked;
-  std::vector<double> first_value, wall;
-  for (const SweepRow& row : rows) {
-    csv += format_row(row, check_names.size()).second + "\n";
-    if (!row.checks.empty()) {
-      picked.push_back(row.picked);
-      first_value.push_back(row.checks[0].first);
-      wall.push_back(row.wall);
-    }
-  }
-  write_file_atomically(out_dir / "sweep.csv", csv);
-  if (!picked.empty()) plot_sweep(out_dir / "sweep.png", axes, picked, first_value, wall, check_names[0]);
+  write_table();
   return all_ok;
 }
 

@@ -365,7 +365,9 @@ LoadCase LoadCase::read(CaseNode& node) {
   load.name = node.string("name");
   if (load.name.empty() || load.name.find_first_of("/\\ ,") != std::string::npos)
     node.fail("name", "expected a non-empty name without spaces, commas or slashes");
-  if (node.has("tension") == node.has("shear")) node.fail("tension", "give exactly one of tension: axis or shear: [face, direction]");
+  if (node.has("tension") == node.has("shear"))
+    node.fail("tension", "give exactly one of tension: axis or shear: [face, direction]" + node.misspelling_hint("tension") +
+                             node.misspelling_hint("shear"));
   if (node.has("tension")) {
     load.face = load.direction = axis_index(node, "tension", node.string("tension"));
   } else {

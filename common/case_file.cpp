@@ -366,16 +366,19 @@ void CaseNode::fail(std::string_view key, std::string_view message) const {
   raise(e.present() ? where(e) : where(), e.path, message);
 }
 
-void CaseNode::missing(std::string_view key, std::string_view expected) const {
-  std::string message = "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")";
-  // A slip of the pen is the likely cause: name a key not read so far that is one.
+std::string CaseNode::misspelling_hint(std::string_view key) const {
   for (const auto& present : keys())
     if (!recognised(present) && is_slip_of(present, key)) {
       const Entry e = find(present);
-      message += "; is '" + present + "' (" + (e.line > 0 ? "line " + std::to_string(e.line) : where(e)) + ") a misspelling of it?";
-      break;
+      return "; is '" + present + "' (" + (e.line > 0 ? "line " + std::to_string(e.line) : where(e)) + ") a misspelling of '" +
+             std::string(key) + "'?";
     }
-  raise(where(), path_, message);
+  return "";
+}
+
+void CaseNode::missing(std::string_view key, std::string_view expected) const {
+  // A slip of the pen is the likely cause: name a key not read so far that is one.
+  raise(where(), path_, "missing required key '" + std::string(key) + "' (" + std::string(expected) + ")" + misspelling_hint(key));
 }
 
 void CaseNode::mismatch(const Entry& e, std::string_view expected) const {

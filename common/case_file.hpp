@@ -102,6 +102,10 @@ class CaseNode {
   // Rejects keys present in this mapping that no accessor asked for.
   void finish() const;
 
+  // "; is 'E_m' (line 6) a misspelling of 'E_mu'?" when a key not asked for so far is a slip of
+  // `key` (one letter dropped, added or swapped with its neighbour, or another case), else "".
+  std::string misspelling_hint(std::string_view key) const;
+
  private:
   friend class CaseFile;
   struct Entry;  // a value with its key path and line; defined in case_file.cpp

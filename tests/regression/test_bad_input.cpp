@@ -109,7 +109,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"end_below_one_step", 2, "time: {end: 1.0e-300, dt: auto}", "",
                  {"case.yaml:2", "time.end", "no step would run"}},
         BadInput{"misspelt_required_key", 6, "  bond: {law: beam, E_m: 2.0e11, r_mu: 0.5}", "",
-                 {"case.yaml:6", "missing required key 'E_mu'", "is 'E_m' (line 6) a misspelling of it?"}},
+                 {"case.yaml:6", "missing required key 'E_mu'", "is 'E_m' (line 6) a misspelling of 'E_mu'?"}},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),

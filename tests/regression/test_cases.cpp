@@ -105,6 +105,12 @@ TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
   r = test::run_arlequin("sweep " + cases + "cantilever_chain/case.yaml --over dem.damping=,,");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--over dem.damping=,,: no values after '='"), std::string::npos) << r.output;
+  // A bad value found at its run ends the sweep; the rows finished before it stay in sweep.csv.
+  const auto sweep_out = test::scratch_dir("sweep_bad_value");
+  r = test::run_arlequin("sweep " + cases + "cantilever_chain/case.yaml --set time.end=1e-3 --over dem.damping=400,abc --out " +
+                         sweep_out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(test::read_text(sweep_out / "sweep.csv").find("\n400,11,0,"), std::string::npos);
 }
 
 // --out must name a folder that can be written: refused before the run, as bad input. `check`

@@ -274,6 +274,13 @@ TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
   r = test::run_arlequin(run + " --sample dens");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--sample dens: no sample of that name; did you mean 'dense'?"), std::string::npos) << r.output;
+  write(dir / "spec.yaml", "case: sample.yaml\ntests: [{name: LT, shaer: [x, z]}]\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("give exactly one of tension: axis or shear: [face, direction]; is 'shaer' (line 2) a misspelling of "
+                          "'shear'?"),
+            std::string::npos)
+      << r.output;
 }
 
 // The REV of cases/rev_elastic reduced to ~2.4k DEs (mean radius 75 um: the matrix between the

@@ -187,7 +187,7 @@ TEST_F(CaseFileTest, MissingRequiredKeyPointsAtItsMisspelling) {
   bond.number("r_mu", Range::positive(), "1");
   EXPECT_CONTAINS(error_of([&] { bond.number("E_mu", Range::positive(), "Pa"); }),
                   "case.yaml:1: bond: missing required key 'E_mu' (a number > 0 [Pa]); is 'E_m' (line 2) a "
-                  "misspelling of it?");
+                  "misspelling of 'E_mu'?");
   // A valid key not read yet is no misspelling, even one substitution away (E_mu simply forgotten).
   CaseFile forgotten = load("bond:\n  r_mu: 0.3\n  nu_mu: 0.2\n");
   CaseNode bond2 = forgotten.root().child("bond");
@@ -195,7 +195,7 @@ TEST_F(CaseFileTest, MissingRequiredKeyPointsAtItsMisspelling) {
   EXPECT_CONTAINS(message, "missing required key 'E_mu'");
   EXPECT_EQ(message.find("misspelling"), std::string::npos) << message;
   CaseFile swapped = load("group:\n  regoin: {box: 1}\n");
-  EXPECT_CONTAINS(error_of([&] { swapped.root().child("group").child("region"); }), "is 'regoin' (line 2) a misspelling of it?");
+  EXPECT_CONTAINS(error_of([&] { swapped.root().child("group").child("region"); }), "is 'regoin' (line 2) a misspelling of 'region'?");
 }
 
 TEST_F(CaseFileTest, MissingFile) {
