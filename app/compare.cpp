@@ -20,7 +20,6 @@ namespace {
 
 struct Run {
   std::string name;
-  std::vector<std::string> sensors;  // the case's sensor columns
   std::vector<std::string> columns;
   std::vector<std::vector<double>> rows;  // series.csv
   double setup = 0.0, loop = 0.0, output = 0.0;
@@ -59,7 +58,6 @@ Run execute(Prepared& prepared, const std::filesystem::path& out) {
   run_options.setup_seconds = prepared.setup_seconds;
   Run run;
   run.name = scene.name;
-  run.sensors = sensor_columns(scene);
   run.particles = scene.dem.particles.size();
   Json counts = Json::object();
   if (scene.continuum) scene.continuum->describe(counts);

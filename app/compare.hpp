@@ -13,7 +13,8 @@
 
 namespace arlequin::app {
 
-// Returns false if a run failed. InputError when the cases share no sensor column.
+// Builds both scenes, then runs them one after the other. Returns false if a run failed.
+// InputError, before any run, when a case is bad or the cases share no sensor column.
 bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                  const SceneOptions& base, const std::filesystem::path& out_dir);
 

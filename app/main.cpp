@@ -64,7 +64,8 @@ constexpr const char* usage_build_sample =
 
 constexpr const char* usage_compare =
     "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--set k=v ...]\n"
-    "  runs both cases (results in DIR/reference and DIR/other, default results/compare), then for\n"
+    "  builds both cases first (a bad case, or none of their sensors shared, stops it before any\n"
+    "  run), runs them (results in DIR/reference and DIR/other, default results/compare), then for\n"
     "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
     "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
     "  compare_<sensor>.png\n";
