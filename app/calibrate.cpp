@@ -14,6 +14,11 @@
 #include "common/png_plot.hpp"
 
 namespace arlequin::app {
+
+Override CalibrationSpec::bond_override(const std::string& leaf, double value) const {
+  return Override(bond_key + "." + leaf + "=" + format("%.17g", value), bond_origin);
+}
+
 namespace {
 
 // Mean of n estimates with uncertainty sqrt(sum u_i^2 / n^2 + s^2 / n) (header).
@@ -33,8 +38,8 @@ Measurement measure(const CalibrationSpec& spec, const SceneOptions& options, do
   Measurement m;
   for (int axis : spec.axes) {
     SceneOptions o = options;
-    o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", E_mu));
-    o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", r_mu));
+    o.overrides.push_back(spec.bond_override("E_mu", E_mu));
+    o.overrides.push_back(spec.bond_override("r_mu", r_mu));
     o.out_dir = dir / axis_names[axis];
     LoadCase load;
     load.name = "tension_" + std::string(axis_names[axis]);
@@ -241,6 +246,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
   CaseNode root = file.root();
   CalibrationSpec spec;
   spec.case_file = root.existing_file("case");
+  spec.bond_origin = root.where("bond") + ": bond";
   spec.bond_key = root.string_or("bond", spec.bond_key);
   const bool elastic = root.has("targets") || !root.has("failure");
   if (elastic) {
@@ -255,7 +261,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
   }
   spec.tolerance = root.number_or("tolerance", spec.tolerance, Range::positive(), "1");
   for (CaseNode v : root.list_or_empty("verify")) {
-    spec.verify.push_back({v.string("name"), v.strings("set")});
+    spec.verify.push_back({v.string("name"), v.overrides("set")});
     v.finish();
   }
   spec.plan = QuasiStatic::read(root.child_if("quasi_static"));
@@ -298,7 +304,7 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
         t.fail("variant", "expected a name of letters, digits and '_' (it names a folder), got '" + target.variant + "'");
       if (t.has("set")) {
         if (target.variant.empty()) t.fail("set", "name the variant these options make (variant: ...)");
-        target.overrides = t.strings("set");
+        target.overrides = t.overrides("set");
       }
       t.finish();
       spec.failure_targets.push_back(target);
@@ -315,8 +321,8 @@ static void calibrate_elastic(const CalibrationSpec& spec, const SceneOptions& o
                        CalibrationResult& result) {
   // The cache key: the case as resolved with fixed placeholder bond values, and the test plan.
   SceneOptions probe_options = options;
-  probe_options.overrides.push_back(spec.bond_key + ".E_mu=1");
-  probe_options.overrides.push_back(spec.bond_key + ".r_mu=1");
+  probe_options.overrides.push_back(spec.bond_override("E_mu", 1.0));
+  probe_options.overrides.push_back(spec.bond_override("r_mu", 1.0));
   const Scene probe = build_scene(spec.case_file, probe_options);
   std::string signature = probe.resolved_case + "\n# plan: " + spec.plan.describe() + "\n# axes:";
   for (int a : spec.axes) signature.append(" ").append(axis_names[a]);
@@ -421,9 +427,9 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
     const auto options_at = [&](double s) {  // the case with this target's bond and strength s
       SceneOptions o = options;
       o.overrides.insert(o.overrides.end(), target.overrides.begin(), target.overrides.end());
-      o.overrides.push_back(spec.bond_key + ".E_mu=" + format("%.17g", strength.E_mu));
-      o.overrides.push_back(spec.bond_key + ".r_mu=" + format("%.17g", strength.r_mu));
-      o.overrides.push_back(bbf ? spec.bond_key + ".sigma_f=" + format("%.17g", s) : "dem.failure.rdef.threshold=" + format("%.17g", s));
+      o.overrides.push_back(spec.bond_override("E_mu", strength.E_mu));
+      o.overrides.push_back(spec.bond_override("r_mu", strength.r_mu));
+      o.overrides.push_back(bbf ? spec.bond_override("sigma_f", s) : Override("dem.failure.rdef.threshold=" + format("%.17g", s)));
       return o;
     };
     if (!bbf) {  // the RDEF threshold alone must decide

@@ -52,7 +52,7 @@ struct FailureTarget {
   std::optional<double> young, E_mu, r_mu;     // Pa, Pa, 1: required without an elastic target of that name
   std::optional<double> initial, reference;   // Pa: first guess (default: reference), a published value
   std::string variant;                        // optional name of a variant of the criterion
-  std::vector<std::string> overrides;         // its case options ("key=value"), e.g. RDEF's average
+  std::vector<Override> overrides;            // its case options ("key=value"), e.g. RDEF's average
   // "bbf", "rdef" or "rdef_<variant>": folders and tables.
   std::string label() const { return variant.empty() ? criterion : criterion + "_" + variant; }
 };
@@ -79,12 +79,15 @@ struct FailureTarget {
 struct CalibrationSpec {
   std::filesystem::path case_file;
   std::string bond_key = "dem.bond";
+  std::string bond_origin = "bond";  // where bond_key was given, for messages about its overrides
+  // `bond_key.leaf=value`, an override of the calibrated bond section.
+  Override bond_override(const std::string& leaf, double value) const;
   std::vector<double> radius_ratios;
   std::vector<int> axes{2};
   double tolerance = 0.002;
   struct Variant {
     std::string name;
-    std::vector<std::string> overrides;
+    std::vector<Override> overrides;
   };
   std::vector<Variant> verify;
   QuasiStatic plan;

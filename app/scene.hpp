@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "app/continuum_part.hpp"
+#include "common/case_file.hpp"
 #include "dem/dem_model.hpp"
 #include "dem/sample_file.hpp"
 
@@ -108,7 +109,7 @@ struct Scene {
 };
 
 struct SceneOptions {
-  std::vector<std::string> overrides;  // --set key=value
+  std::vector<Override> overrides;     // --set key=value, and those of sweeps and spec files
   std::filesystem::path out_dir;       // --out, empty = from the case
   std::string petsc_options;           // --petsc "...", after the case's own
   bool rebuild_sample = false;         // build the packing even if its cache file matches

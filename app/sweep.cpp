@@ -165,7 +165,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
     SweepRow row;
     for (std::size_t k = 0, rest = run; k < axes.size(); rest /= axes[k].values.size(), ++k) {
       row.picked.push_back(axes[k].values[rest % axes[k].values.size()]);
-      options.overrides.push_back(axes[k].key + "=" + row.picked.back());
+      options.overrides.push_back(Override(axes[k].key + "=" + row.picked.back(), "--over"));
     }
     const auto t0 = std::chrono::steady_clock::now();
     RunOptions run_options;

@@ -206,7 +206,7 @@ Json estimate_json(const Estimate& e) {
 
 struct SampleVariant {
   std::string name;
-  std::vector<std::string> overrides;
+  std::vector<Override> overrides;
 };
 
 // The engineering constants of a unidirectional composite, in table order.
@@ -378,7 +378,7 @@ LoadCase LoadCase::read(CaseNode& node) {
     if (load.face == load.direction) node.fail("shear", "the direction must differ from the face normal (that is tension)");
   }
   if (node.has("modulus_estimate")) load.modulus_estimate = node.number("modulus_estimate", Range::positive(), "Pa");
-  load.overrides = node.strings_or("set", {});
+  load.overrides = node.overrides_or_empty("set");
   return load;
 }
 
@@ -800,7 +800,7 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   const std::filesystem::path case_file = root.existing_file("case");
   std::vector<SampleVariant> samples;
   for (CaseNode s : root.list_or_empty("samples")) {
-    samples.push_back({s.string("name"), s.strings_or("set", {})});
+    samples.push_back({s.string("name"), s.overrides_or_empty("set")});
     // Each sample's results go in a folder of its name.
     if (samples.back().name.empty() || samples.back().name.find_first_of("/\\ ,") != std::string::npos)
       s.fail("name", "expected a non-empty name without spaces, commas or slashes");

@@ -63,7 +63,7 @@ struct LoadCase {
   int face = 2;       // the loaded faces are normal to this axis
   int direction = 2;  // the upper face moves along this axis
   std::optional<double> modulus_estimate;  // Pa, for the time scale; none: affine estimate
-  std::vector<std::string> overrides;      // the test's own `set: [key=value, ...]`, after the sample's
+  std::vector<Override> overrides;         // the test's own `set: [key=value, ...]`, after the sample's
 
   bool shear() const { return face != direction; }
   std::string describe() const;  // "tension along z", "shear of the z faces along x"

@@ -187,11 +187,12 @@ std::string read_text(const std::filesystem::path& file) {
   return text.str();
 }
 
-// Applies one "--set a.b.c=value": replaces or creates the key, creating mappings on the way.
-void apply_override(detail::CaseState& s, const std::string& text) {
-  const std::string where = "--set " + text;
+// Applies one "a.b.c=value" override: replaces or creates the key, creating mappings on the way.
+void apply_override(detail::CaseState& s, const Override& o) {
+  const std::string& text = o.text;
+  const std::string where = o.where();
   const auto eq = text.find('=');
-  if (eq == std::string::npos) raise(where, "", "expected --set key.path=value");
+  if (eq == std::string::npos) raise(where, "", "expected key.path=value");
   std::vector<std::string> keys;
   std::string path = text.substr(0, eq);
   std::erase_if(path, [](char c) { return std::isspace(static_cast<unsigned char>(c)); });
@@ -586,6 +587,26 @@ std::vector<std::string> CaseNode::strings(std::string_view key) {
   return out;
 }
 
+std::string CaseNode::where(std::string_view key) const {
+  const Entry e = find(key);
+  return e.present() ? where(e) : where();
+}
+
+std::vector<Override> CaseNode::overrides(std::string_view key) {
+  const std::string origin = where(key) + ": " + key_path(key);
+  std::vector<Override> out;
+  for (std::string& text : strings(key)) out.emplace_back(std::move(text), origin);
+  return out;
+}
+
+std::vector<Override> CaseNode::overrides_or_empty(std::string_view key) {
+  if (!find(key).present()) {
+    strings_or(key, {});  // records the (empty) default
+    return {};
+  }
+  return overrides(key);
+}
+
 std::vector<std::string> CaseNode::strings_or(std::string_view key, const std::vector<std::string>& fallback) {
   if (!find(key).present()) {
     lookup(key);
@@ -685,7 +706,7 @@ void CaseNode::finish() const {
 
 // ---- CaseFile ------------------------------------------------------------------------
 
-CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<Override>& overrides) {
   auto state = std::make_shared<detail::CaseState>();
   state->file = file;
   state->folder = std::filesystem::absolute(file).lexically_normal().parent_path();

@@ -52,6 +52,17 @@ struct CaseState;
 struct CaseRecord;
 }  // namespace detail
 
+// One "a.b.c=value" override of a case (the value is parsed as YAML) and where it was given:
+// "--set" (the command line, the default), "--over", or a spec file's line and key, e.g.
+// "spec.yaml:14: samples[1].set". Messages about what it set name that origin.
+struct Override {
+  std::string text;
+  std::string origin = "--set";
+  Override(std::string text_, std::string origin_ = "--set") : text(std::move(text_)), origin(std::move(origin_)) {}
+  Override(const char* text_) : text(text_) {}
+  std::string where() const { return origin.starts_with("--") ? origin + " " + text : origin + ": " + text; }
+};
+
 // A view on one mapping of a case document (a section, or an item of a list of mappings).
 // Cheap to copy; all views of one CaseFile share its state.
 class CaseNode {
@@ -94,6 +105,7 @@ class CaseNode {
   void accept_any_keys();
 
   std::string where() const;  // "case.yaml:12" or "--set a.b=1"
+  std::string where(std::string_view key) const;  // of that key if present, else of this mapping
   const std::string& path() const { return path_; }  // "dem.sample"; "" for the top level
   std::string key_path(std::string_view key) const;
   // Throws InputError "<where of key>: <path.key>: <message>" (semantic checks by callers).
@@ -101,6 +113,11 @@ class CaseNode {
 
   // Rejects keys present in this mapping that no accessor asked for.
   void finish() const;
+
+  // A list of "key=value" overrides, each with this key's place as its origin ("spec.yaml:14:
+  // samples[1].set"); required, or empty when absent.
+  std::vector<Override> overrides(std::string_view key);
+  std::vector<Override> overrides_or_empty(std::string_view key);
 
   // "; is 'E_m' (line 6) a misspelling of 'E_mu'?" when a key not asked for so far is a slip of
   // `key` (one letter dropped, added or swapped with its neighbour, or another case), else "".
@@ -133,12 +150,10 @@ class CaseNode {
   detail::CaseRecord* record_;  // this mapping's part of the resolved document
 };
 
-// A loaded case document with its command-line overrides applied.
+// A loaded case document with its overrides applied.
 class CaseFile {
  public:
-  // `overrides` are "a.b.c=value" texts from --set; the value is parsed as YAML.
-  static CaseFile load(const std::filesystem::path& file,
-                       const std::vector<std::string>& overrides = {});
+  static CaseFile load(const std::filesystem::path& file, const std::vector<Override>& overrides = {});
 
   CaseNode root();
   // YAML of every value read so far (defaults included), in read order.

@@ -111,6 +111,7 @@ TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
                          sweep_out.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(test::read_text(sweep_out / "sweep.csv").find("\n400,11,0,"), std::string::npos);
+  EXPECT_NE(r.output.find("--over dem.damping=abc: dem.damping: expected a number"), std::string::npos) << r.output;
 }
 
 // --out must name a folder that can be written: refused before the run, as bad input. `check`

@@ -274,6 +274,13 @@ TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
   r = test::run_arlequin(run + " --sample dens");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--sample dens: no sample of that name; did you mean 'dense'?"), std::string::npos) << r.output;
+  // A spec's own override names its line and key, not a --set the user never typed.
+  write(dir / "spec.yaml", "case: sample.yaml\nsamples: [{name: a, set: [dem.dampng=1]}]\ntests: [{name: L, tension: z}]\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("spec.yaml:2: samples[0].set: dem.dampng=1: dem.dampng: unknown key; did you mean 'damping'?"),
+            std::string::npos)
+      << r.output;
   write(dir / "spec.yaml", "case: sample.yaml\ntests: [{name: LT, shaer: [x, z]}]\n");
   r = test::run_arlequin(run);
   EXPECT_EQ(r.exit_code, 2);

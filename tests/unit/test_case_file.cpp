@@ -27,7 +27,7 @@ class CaseFileTest : public test::ScratchDirTest {
     std::ofstream(file) << text;
     return file;
   }
-  CaseFile load(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  CaseFile load(const std::string& text, const std::vector<Override>& overrides = {}) {
     return CaseFile::load(write(text), overrides);
   }
 };
@@ -232,7 +232,7 @@ TEST_F(CaseFileTest, OverridesReplaceAndCreateValues) {
 TEST_F(CaseFileTest, MalformedOverridesAreNamed) {
   const fs::path file = write(kCase);
   EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time.end"}); }),
-                  "--set time.end: expected --set key.path=value");
+                  "--set time.end: expected key.path=value");
   EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"=3"}); }), "--set =3: empty key");
   EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time..end=3"}); }), "--set time..end=3: empty key");
   EXPECT_CONTAINS(error_of([&] { CaseFile::load(file, {"time.end.x=3"}); }),
