@@ -253,10 +253,15 @@ CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
     spec.radius_ratios = root.numbers("r_mu", Range::positive(), "1");
     std::sort(spec.radius_ratios.begin(), spec.radius_ratios.end());
     if (spec.radius_ratios.size() < 2) root.fail("r_mu", "expected at least two values to interpolate between");
+    if (std::adjacent_find(spec.radius_ratios.begin(), spec.radius_ratios.end()) != spec.radius_ratios.end())
+      root.fail("r_mu", "a grid value is given twice (each is a set of runs)");
   }
   if (root.has("axes")) {
     spec.axes.clear();
-    for (const std::string& a : root.strings("axes")) spec.axes.push_back(axis_index(root, "axes", a));
+    for (const std::string& a : root.strings("axes")) {
+      spec.axes.push_back(axis_index(root, "axes", a));
+      if (std::count(spec.axes.begin(), spec.axes.end(), spec.axes.back()) > 1) root.fail("axes", "axis " + a + " is given twice");
+    }
     if (spec.axes.empty()) root.fail("axes", "expected at least one axis");
   }
   spec.tolerance = root.number_or("tolerance", spec.tolerance, Range::positive(), "1");

@@ -113,6 +113,27 @@ TEST(VirtualTests, HomogeneousPackingIsIsotropicAndScalesWithEmu) {
 
 // A coarse calibration through the command line: the pair hits the target on its packing, the
 // curve is written and plotted, and a second calibration reuses the cached curve points.
+// A grid value or an axis given twice would only repeat runs: refused, as is a bond section that
+// is none, at the spec's own line.
+TEST(Calibration, RepeatsAndAWrongBondSectionAreRefused) {
+  const auto dir = test::scratch_dir("calibration_bad_spec");
+  homogeneous_case(dir);
+  const std::string run = "calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "out").string();
+  const std::string targets = "targets: [{name: epoxy, E: 3.45e9, nu: 0.3, reference: {E_mu: 89.0e9, r_mu: 0.33}}]\n";
+  write(dir / "calibration.yaml", "case: sample.yaml\nr_mu: [0.3, 0.2, 0.2]\n" + targets);
+  auto r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("calibration.yaml:2: r_mu: a grid value is given twice"), std::string::npos) << r.output;
+  write(dir / "calibration.yaml", "case: sample.yaml\nr_mu: [0.2, 0.3]\naxes: [x, x]\n" + targets);
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("calibration.yaml:3: axes: axis x is given twice"), std::string::npos) << r.output;
+  write(dir / "calibration.yaml", "case: sample.yaml\nbond: dem.bnd\nr_mu: [0.2, 0.3]\n" + targets);
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("calibration.yaml:2: bond: dem.bnd.E_mu=1: dem.bnd: unknown key"), std::string::npos) << r.output;
+}
+
 TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   const auto dir = test::scratch_dir("calibration_coarse");
   homogeneous_case(dir);
