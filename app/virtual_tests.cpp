@@ -353,6 +353,21 @@ std::string csv_row(const std::string& sample, const VirtualTestResult& r, const
   return row + "," + status + "\n";
 }
 
+// The `name` of a test or a sample: it names the folder of its results.
+std::string folder_name(CaseNode& node) {
+  std::string name = node.string("name");
+  if (name.empty() || name.find_first_of("/\\ ,") != std::string::npos)
+    node.fail("name", "expected a non-empty name without spaces, commas or slashes");
+  return name;
+}
+
+// The last of `items` (tests or samples, read from `node`) must not share its folder name.
+template <class Named>
+void require_new_name(const CaseNode& node, const std::vector<Named>& items, const char* kind) {
+  for (std::size_t k = 0; k + 1 < items.size(); ++k)
+    if (items[k].name == items.back().name) node.fail("name", std::string(kind) + " '" + items.back().name + "' is defined twice");
+}
+
 }  // namespace
 
 std::string LoadCase::describe() const {
@@ -362,9 +377,7 @@ std::string LoadCase::describe() const {
 
 LoadCase LoadCase::read(CaseNode& node) {
   LoadCase load;
-  load.name = node.string("name");
-  if (load.name.empty() || load.name.find_first_of("/\\ ,") != std::string::npos)
-    node.fail("name", "expected a non-empty name without spaces, commas or slashes");
+  load.name = folder_name(node);
   if (node.has("tension") == node.has("shear"))
     node.fail("tension", "give exactly one of tension: axis or shear: [face, direction]" + node.misspelling_hint("tension") +
                              node.misspelling_hint("shear"));
@@ -800,12 +813,9 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   const std::filesystem::path case_file = root.existing_file("case");
   std::vector<SampleVariant> samples;
   for (CaseNode s : root.list_or_empty("samples")) {
-    samples.push_back({s.string("name"), s.overrides_or_empty("set")});
-    // Each sample's results go in a folder of its name.
-    if (samples.back().name.empty() || samples.back().name.find_first_of("/\\ ,") != std::string::npos)
-      s.fail("name", "expected a non-empty name without spaces, commas or slashes");
-    for (std::size_t k = 0; k + 1 < samples.size(); ++k)
-      if (samples[k].name == samples.back().name) s.fail("name", "sample '" + samples.back().name + "' is defined twice");
+    const std::string name = folder_name(s);
+    samples.push_back({name, s.overrides_or_empty("set")});
+    require_new_name(s, samples, "sample");
     s.finish();
   }
   if (samples.empty()) samples.push_back({"base", {}});
@@ -827,8 +837,7 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   std::vector<std::optional<FailureReference>> references;
   for (CaseNode t : root.list("tests")) {
     tests.push_back(LoadCase::read(t));
-    for (std::size_t k = 0; k + 1 < tests.size(); ++k)  // each test's results go in a folder of its name
-      if (tests[k].name == tests.back().name) t.fail("name", "test '" + tests.back().name + "' is defined twice");
+    require_new_name(t, tests, "test");
     if (failure_node) {
       if (tests.back().shear()) t.fail("shear", "a test to failure (failure section) is a tension test");
       references.push_back(FailureReference::read(t.child_if("reference")));

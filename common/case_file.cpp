@@ -362,10 +362,7 @@ std::string CaseNode::key_path(std::string_view key) const {
   return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
 }
 
-void CaseNode::fail(std::string_view key, std::string_view message) const {
-  const Entry e = find(key);
-  raise(e.present() ? where(e) : where(), e.path, message);
-}
+void CaseNode::fail(std::string_view key, std::string_view message) const { raise(where(key), key_path(key), message); }
 
 std::string CaseNode::misspelling_hint(std::string_view key) const {
   for (const auto& present : keys())
