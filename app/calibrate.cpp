@@ -411,6 +411,44 @@ static void calibrate_elastic(const CalibrationSpec& spec, const SceneOptions& o
   }
 }
 
+// The case of a failure target's runs: its overrides, the bond pair (E_mu, r_mu) and strength s
+// (BBF sigma_f, or the RDEF threshold).
+static SceneOptions failure_target_options(const CalibrationSpec& spec, const SceneOptions& options, const FailureTarget& target,
+                                           double E_mu, double r_mu, double s) {
+  SceneOptions o = options;
+  o.overrides.insert(o.overrides.end(), target.overrides.begin(), target.overrides.end());
+  o.overrides.push_back(spec.bond_override("E_mu", E_mu));
+  o.overrides.push_back(spec.bond_override("r_mu", r_mu));
+  o.overrides.push_back(target.criterion == "bbf" ? spec.bond_override("sigma_f", s)
+                                                  : Override("dem.failure.rdef.threshold=" + format("%.17g", s)));
+  return o;
+}
+
+// Before any run, the case is read with each verify sample's and each failure target's
+// overrides as their runs will read it (the bond values not yet calibrated are placeholders), so
+// that a bad override stops calibrate at once rather than after the r_mu grid.
+static void check_every_variant(const CalibrationSpec& spec, const SceneOptions& options) {
+  SceneOptions base = options;
+  base.check_output_dir = false;
+  for (const CalibrationSpec::Variant& sample : spec.verify) {
+    SceneOptions o = base;
+    o.overrides.insert(o.overrides.end(), sample.overrides.begin(), sample.overrides.end());
+    o.overrides.push_back(spec.bond_override("E_mu", 1.0));
+    o.overrides.push_back(spec.bond_override("r_mu", 1.0));
+    build_scene(spec.case_file, o);
+  }
+  for (const FailureTarget& target : spec.failure_targets) {
+    const double first_guess = target.initial ? *target.initial : *target.reference;
+    const Scene probe = build_scene(spec.case_file, failure_target_options(spec, base, target, target.E_mu.value_or(1.0),
+                                                                           target.r_mu.value_or(1.0), first_guess));
+    if (target.criterion == "rdef")  // the RDEF threshold alone must decide
+      for (const auto& set : probe.dem.bond_sets())
+        if (set->has_strength())
+          throw InputError(spec.case_file.string() + ": bond set '" + set->name + "' has a BBF strength (sigma_f); the RDEF target '" +
+                           target.name + "' needs a case without one");
+  }
+}
+
 // The strengths (header): tests to failure with s_{n+1} = s_n target / sigma_n.
 static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir,
                          CalibrationResult& result) {
@@ -427,25 +465,9 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
     LoadCase load;
     load.name = "tension_" + std::string(axis_names[spec.failure_axis]);
     load.face = load.direction = spec.failure_axis;
-    const bool bbf = target.criterion == "bbf";
     double threshold = target.initial ? *target.initial : *target.reference;
-    const auto options_at = [&](double s) {  // the case with this target's bond and strength s
-      SceneOptions o = options;
-      o.overrides.insert(o.overrides.end(), target.overrides.begin(), target.overrides.end());
-      o.overrides.push_back(spec.bond_override("E_mu", strength.E_mu));
-      o.overrides.push_back(spec.bond_override("r_mu", strength.r_mu));
-      o.overrides.push_back(bbf ? spec.bond_override("sigma_f", s) : Override("dem.failure.rdef.threshold=" + format("%.17g", s)));
-      return o;
-    };
-    if (!bbf) {  // the RDEF threshold alone must decide
-      const Scene probe = build_scene(spec.case_file, options_at(threshold));
-      for (const auto& set : probe.dem.bond_sets())
-        if (set->has_strength())
-          throw InputError(spec.case_file.string() + ": bond set '" + set->name + "' has a BBF strength (sigma_f); the RDEF target '" +
-                           target.name + "' needs a case without one");
-    }
     for (int round = 0; round < 5; ++round) {
-      SceneOptions o = options_at(threshold);
+      SceneOptions o = failure_target_options(spec, options, target, strength.E_mu, strength.r_mu, threshold);
       o.out_dir = out_dir / target.name / ("failure_" + target.label()) / ("round_" + std::to_string(round));
       const FailureTestResult test = run_failure_test(spec.case_file, o, load, plan);
       strength.rounds.push_back({threshold, test});
@@ -468,6 +490,7 @@ static void calibrate_strengths(const CalibrationSpec& spec, const SceneOptions&
 }
 
 CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir) {
+  check_every_variant(spec, options);
   CalibrationResult result;
   if (!spec.targets.empty()) calibrate_elastic(spec, options, out_dir, result);
   calibrate_strengths(spec, options, out_dir, result);

@@ -144,8 +144,11 @@ struct CalibrationResult {
 // Runs the calibration into out_dir (runs in out_dir/curve/r_<r_mu>/<axis>/,
 // out_dir/<target>/<sample>/<axis>/ and out_dir/<target>/failure_<criterion>/round_<n>/), writes
 // curve.csv, curve.png (with elastic targets), strength.csv (with failure targets),
-// calibration.md and calibration.json there, and prints the curve, the pairs and strengths. options' overrides apply to the case. InputError
-// if a target's nu_M is outside the curve's range (widen r_mu); RunError if a run stops.
+// calibration.md and calibration.json there, and prints the curve, the pairs and strengths.
+// options' overrides apply to the case. Before any run the case is read with each verify
+// sample's and each failure target's overrides: InputError for a bad one, or for an RDEF target
+// whose case has a BBF strength. InputError if a target's nu_M is outside the curve's range
+// (widen r_mu); RunError if a run stops.
 CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir);
 
 }  // namespace arlequin::app

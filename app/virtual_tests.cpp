@@ -207,6 +207,18 @@ Json estimate_json(const Estimate& e) {
 struct SampleVariant {
   std::string name;
   std::vector<Override> overrides;
+
+  bool selected(const std::vector<std::string>& only_samples) const {  // by --sample (all when none is given)
+    return only_samples.empty() || std::find(only_samples.begin(), only_samples.end(), name) != only_samples.end();
+  }
+  // The options of a test's run on this sample: the caller's, then this sample's overrides; its
+  // outputs in out_dir/<sample>/<test>.
+  SceneOptions options_for(const SceneOptions& caller, const std::string& test, const std::filesystem::path& out_dir) const {
+    SceneOptions o = caller;
+    o.overrides.insert(o.overrides.end(), overrides.begin(), overrides.end());
+    o.out_dir = out_dir / name / test;
+    return o;
+  }
 };
 
 // The engineering constants of a unidirectional composite, in table order.
@@ -721,9 +733,14 @@ namespace {
 
 // A published range for a test to failure (e.g. seed Table 4 over its samples).
 struct FailureReference {
+  struct Broken {
+    std::string set;                // a bond set of the case
+    std::array<double, 2> percent;  // %
+    std::string where;              // "spec.yaml:12: tests[0].reference.broken.fibre"
+  };
   std::string name;
   std::array<double, 2> stress{}, strain{};  // Pa; 1
-  std::vector<std::pair<std::string, std::array<double, 2>>> broken;  // bond set, percent
+  std::vector<Broken> broken;
 
   static std::optional<FailureReference> read(std::optional<CaseNode> node) {
     if (!node) return std::nullopt;
@@ -737,7 +754,8 @@ struct FailureReference {
     r.stress = range(*node, "stress", "Pa");
     r.strain = range(*node, "strain", "1");
     if (auto broken = node->child_if("broken")) {
-      for (const std::string& set : broken->keys()) r.broken.emplace_back(set, range(*broken, set, "%"));
+      for (const std::string& set : broken->keys())
+        r.broken.push_back({set, range(*broken, set, "%"), broken->where(set) + ": " + broken->key_path(set)});
       broken->finish();
     }
     node->finish();
@@ -752,6 +770,41 @@ std::string describe_failure(const FailureTestResult& r) {
          std::to_string(r.particles) + " DEs, " + std::to_string(r.steps) + " steps" + format(", wall %.1f s", r.wall_seconds);
 }
 
+// Every selected sample with every test, read as its run will read it (TestSetup's probe), before
+// any run: a bad override in a sample's or a test's set:, or a reference to a bond set the case
+// lacks, then stops the suite at once rather than when that test starts, maybe hours in. The
+// packings the runs load are built (and cached) here instead of at their first test.
+void check_every_test(const std::filesystem::path& case_file, const SceneOptions& options, const std::vector<SampleVariant>& samples,
+                      const std::vector<std::string>& only_samples, const std::vector<LoadCase>& tests,
+                      const std::vector<std::optional<FailureReference>>& references) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::size_t checked = 0;
+  for (const SampleVariant& sample : samples) {
+    if (!sample.selected(only_samples)) continue;
+    for (std::size_t t = 0; t < tests.size(); ++t) {
+      SceneOptions o = TestSetup::with_test_overrides(sample.options_for(options, tests[t].name, {}), tests[t]);
+      o.check_output_dir = false;
+      const Scene scene = build_scene(case_file, o);
+      ++checked;
+      if (t >= references.size() || !references[t]) continue;
+      std::vector<std::string_view> sets;
+      std::string listed;
+      for (const auto& set : scene.dem.bond_sets()) {
+        sets.push_back(set->name);
+        listed += (listed.empty() ? "" : ", ") + set->name;
+      }
+      for (const auto& b : references[t]->broken)
+        if (std::find(sets.begin(), sets.end(), b.set) == sets.end()) {
+          const auto guess = closest_match(b.set, sets);
+          throw InputError(b.where + ": the case has no bond set '" + b.set + "'" +
+                           (guess ? "; did you mean '" + std::string(*guess) + "'?" : " (its bond sets: " + listed + ")"));
+        }
+    }
+  }
+  std::printf("read the case of each test with its overrides before any run (%zu tests): %.1f s\n", checked,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
 int run_failure_suite(const std::filesystem::path& case_file, const SceneOptions& options, const std::filesystem::path& out_dir,
                       const std::vector<SampleVariant>& samples, const std::vector<std::string>& only_samples,
                       const std::vector<LoadCase>& tests, const std::vector<std::optional<FailureReference>>& references,
@@ -763,14 +816,11 @@ int run_failure_suite(const std::filesystem::path& case_file, const SceneOptions
                    "|---|---|---|---|---|---|---|---|---|\n";
   int stopped = 0;
   for (const SampleVariant& sample : samples) {
-    if (!only_samples.empty() && std::find(only_samples.begin(), only_samples.end(), sample.name) == only_samples.end()) continue;
+    if (!sample.selected(only_samples)) continue;
     for (std::size_t t = 0; t < tests.size(); ++t) {
       const LoadCase& load = tests[t];
-      SceneOptions test_options = options;
-      test_options.overrides.insert(test_options.overrides.end(), sample.overrides.begin(), sample.overrides.end());
-      test_options.out_dir = out_dir / sample.name / load.name;
       try {
-        const FailureTestResult r = run_failure_test(case_file, test_options, load, plan);
+        const FailureTestResult r = run_failure_test(case_file, sample.options_for(options, load.name, out_dir), load, plan);
         std::printf("%s %s: %s\n", sample.name.c_str(), load.name.c_str(), describe_failure(r).c_str());
         csv += sample.name + "," + load.name + "," + load.describe() + "," + std::to_string(r.particles) + "," +
                std::to_string(r.bonds) + "," + std::to_string(r.steps);
@@ -790,8 +840,8 @@ int run_failure_suite(const std::filesystem::path& case_file, const SceneOptions
       }
       if (const auto& ref = references[t]) {
         std::string broken;
-        for (const auto& [name, range] : ref->broken)
-          broken += (broken.empty() ? "" : ", ") + name + format(" %.3g", range[0]) + format("-%.3g", range[1]);
+        for (const auto& b : ref->broken)
+          broken += (broken.empty() ? "" : ", ") + b.set + format(" %.3g", b.percent[0]) + format("-%.3g", b.percent[1]);
         md += "| " + ref->name + " | " + load.name + " | | " + format("%.2f", ref->stress[0] * 1e-9) + format("-%.2f", ref->stress[1] * 1e-9) +
               " | " + format("%.2f", ref->strain[0] * 1e3) + format("-%.2f", ref->strain[1] * 1e3) + " | | | " + broken + " | |\n";
       }
@@ -844,15 +894,13 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
     }
     t.finish();
   }
-  if (failure_node) {
-    if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
-    const FailurePlan failure = FailurePlan::read(failure_node);
-    root.finish();
-    return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, failure);
-  }
+  std::optional<FailurePlan> failure;
   std::optional<CompositeSpec> composite;
   std::optional<CompositeTests> roles;
-  if (auto node = root.child_if("composite")) {
+  if (failure_node) {
+    if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
+    failure = FailurePlan::read(failure_node);
+  } else if (auto node = root.child_if("composite")) {
     composite = CompositeSpec::read(*node);
     roles = CompositeTests::find(root, tests);
     const Constants theory = composite->theory();
@@ -860,6 +908,8 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
       if (!tests[i].modulus_estimate) tests[i].modulus_estimate = roles->estimate(i, theory);
   }
   root.finish();
+  check_every_test(case_file, options, samples, only_samples, tests, references);
+  if (failure) return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, *failure);
 
   std::printf("virtual tests of %s: %s\n", case_file.string().c_str(), plan.describe().c_str());
   std::string csv = csv_header();
@@ -869,14 +919,11 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   std::vector<std::array<double, 4>> walls;
   int stopped = 0;
   for (const SampleVariant& sample : samples) {
-    if (!only_samples.empty() && std::find(only_samples.begin(), only_samples.end(), sample.name) == only_samples.end()) continue;
+    if (!sample.selected(only_samples)) continue;
     std::vector<VirtualTestResult> results;
     for (const LoadCase& load : tests) {
-      SceneOptions test_options = options;
-      test_options.overrides.insert(test_options.overrides.end(), sample.overrides.begin(), sample.overrides.end());
-      test_options.out_dir = out_dir / sample.name / load.name;
       try {
-        results.push_back(run_virtual_test(case_file, test_options, load, plan));
+        results.push_back(run_virtual_test(case_file, sample.options_for(options, load.name, out_dir), load, plan));
         std::printf("%s %s (%s): %s\n", sample.name.c_str(), load.name.c_str(), load.describe().c_str(),
                     describe_result(results.back()).c_str());
         csv += csv_row(sample.name, results.back(), "ok");

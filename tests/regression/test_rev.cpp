@@ -134,6 +134,30 @@ TEST(Calibration, RepeatsAndAWrongBondSectionAreRefused) {
   EXPECT_NE(r.output.find("calibration.yaml:2: bond: dem.bnd.E_mu=1: dem.bnd: unknown key"), std::string::npos) << r.output;
 }
 
+// The overrides of a verify sample and of a failure target are read before the r_mu grid's
+// first run, not after it, as is the check that an RDEF target's case has no BBF strength.
+TEST(Calibration, VerifyAndTargetOverridesAreReadBeforeAnyRun) {
+  const auto dir = test::scratch_dir("calibration_early_overrides");
+  homogeneous_case(dir);
+  const std::string run = "calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "out").string();
+  const std::string grid = "case: sample.yaml\nr_mu: [0.2, 0.3]\ntargets: [{name: epoxy, E: 3.45e9, nu: 0.3}]\n";
+  write(dir / "calibration.yaml", grid + "verify: [{name: other, set: [dem.dampng=1]}]\n");
+  auto r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("calibration.yaml:4: verify[0].set: dem.dampng=1: dem.dampng: unknown key; did you mean 'damping'?"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "curve")) << "a grid run started";
+  write(dir / "calibration.yaml", grid +
+                                      "failure:\n  targets:\n    - {name: epoxy, criterion: rdef, variant: averaged, stress: 7.0e7, "
+                                      "reference: 1.48e8,\n       set: [dem.failure.rdef.average=bonded_neighbour]}\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("calibration.yaml:7: failure.targets[0].set: dem.failure.rdef.average=bonded_neighbour"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "curve")) << "a grid run started";
+}
+
 TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   const auto dir = test::scratch_dir("calibration_coarse");
   homogeneous_case(dir);
@@ -309,6 +333,30 @@ TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
                           "'shear'?"),
             std::string::npos)
       << r.output;
+}
+
+// Every sample with every test is read before the first run: a bad override of the second test,
+// or a reference to a bond set the case lacks, stops the suite before the first test runs.
+TEST(VirtualTests, EveryTestIsReadBeforeTheFirstRuns) {
+  const auto dir = test::scratch_dir("virtual_tests_early_overrides");
+  homogeneous_case(dir);
+  const std::string run = "virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string();
+  write(dir / "spec.yaml", "case: sample.yaml\ntests: [{name: L, tension: z}, {name: T, tension: x, set: [dem.dampng=1]}]\n");
+  auto r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("spec.yaml:2: tests[1].set: dem.dampng=1: dem.dampng: unknown key; did you mean 'damping'?"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
+  write(dir / "spec.yaml",
+        "case: sample.yaml\nfailure: {expected_strain: 0.01}\ntests:\n  - {name: L, tension: z,\n"
+        "     reference: {name: seed, stress: [1.0e9, 2.0e9], strain: [0.01, 0.02], broken: {bond: [1, 2]}}}\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("spec.yaml:5: tests[0].reference.broken.bond: the case has no bond set 'bond'; did you mean 'bonds'?"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
 }
 
 // The REV of cases/rev_elastic reduced to ~2.4k DEs (mean radius 75 um: the matrix between the
