@@ -10,12 +10,12 @@ namespace arlequin {
 // Loops of at most this many items run on one thread: below it, starting threads costs more
 // than it saves.
 inline constexpr long parallel_threshold = 4096;
-// The same for loops over bonds (one colour of a bond set), whose items cost 10-100 times a
-// DE's update: a random packing's bond sets colour into ~20 colours of a few hundred to a few
-// thousand bonds, which parallel_threshold kept on one thread (the 10k REV: 3.3 ms per step on
-// 2 threads against 1.8 ms at 512, 2026-11-25). 256, not 512, also puts the ~330-bond colours
-// of the coupled wave bar's lattice on threads (2 threads: 150 -> 131 us per step; the 10k REV
-// 1.62 -> 1.53 ms; bench_coupled_step and rev_elastic, alternated, 2026-11-25).
+// The same for bonds, per colour of a bond set on average (dem::for_each_bond). A bond costs
+// 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
+// hundred to a few thousand bonds, which parallel_threshold kept on one thread (the 10k REV:
+// 3.3 ms per step on 2 threads against 1.8 ms at 512, 2026-11-25). 256, not 512, also puts the
+// ~330-bond colours of the coupled wave bar's lattice on threads (2 threads: 150 -> 131 us per
+// step; the 10k REV 1.62 -> 1.53 ms; bench_coupled_step and rev_elastic, alternated, 2026-11-25).
 inline constexpr long parallel_threshold_bonds = 256;
 
 // sum over i < n of term(i), each term evaluated once (it may update state of item i): fixed

@@ -262,8 +262,8 @@ TEST(ForceScan, RecordingLeavesTheForcesUnchanged) {
 }
 
 #ifdef _OPENMP
-// The force pass with a failure scan runs a colour's bonds on threads (above
-// parallel_threshold_bonds): forces, torques, BBF measures and virials are the same to the bit
+// The force pass with a failure scan runs the colours' bonds on threads (more than
+// parallel_threshold_bonds per colour on average): forces, torques, BBF measures and virials are the same to the bit
 // on 1 and 2 threads, and so are the failures found.
 TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   DemModel model;
