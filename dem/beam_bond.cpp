@@ -1,32 +1,83 @@
 #include "dem/beam_bond.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+
+#if defined(__AVX512F__)
+// GCC 12's _mm512_sqrt_pd starts from _mm512_undefined_pd: a false -Wuninitialized.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#include <immintrin.h>
+#pragma GCC diagnostic pop
+#endif
 
 #include "common/case_file.hpp"
 
 namespace arlequin::dem {
 namespace {
 
+// The kinematics of BeamBondSet::block bonds at once, one bond per lane of a GCC vector (one
+// AVX-512 register; the compiler splits it on narrower CPUs): the Vec3 algebra of
+// common/vec3.hpp and quat.hpp, lane by lane. Every bond, alone or in a block, goes through
+// this one kernel, so a bond's actions do not depend on the bonds it is evaluated with.
+constexpr std::size_t lanes = BeamBondSet::block;
+using Lanes = double __attribute__((vector_size(lanes * sizeof(double))));
+
+struct LaneVec {
+  Lanes x, y, z;
+};
+struct LaneQuat {
+  Lanes w;
+  LaneVec v;
+};
+inline LaneVec operator+(const LaneVec& a, const LaneVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline LaneVec operator-(const LaneVec& a, const LaneVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline LaneVec operator*(const LaneVec& a, Lanes s) { return {a.x * s, a.y * s, a.z * s}; }
+inline LaneVec operator*(Lanes s, const LaneVec& a) { return a * s; }
+inline LaneVec operator*(double s, const LaneVec& a) { return {a.x * s, a.y * s, a.z * s}; }
+inline Lanes dot(const LaneVec& a, const LaneVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline LaneVec cross(const LaneVec& a, const LaneVec& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// R(q) a = a + 2w (v x a) + 2 v x (v x a), as common/quat.hpp's rotate.
+inline LaneVec rotate(const LaneQuat& q, const LaneVec& a) {
+  const LaneVec t = 2.0 * cross(q.v, a);
+  return a + q.w * t + cross(q.v, t);
+}
+inline Lanes lane_sqrt(Lanes x) {
+#if defined(__AVX512F__)
+  static_assert(lanes == 8);
+  return _mm512_sqrt_pd(x);  // one instruction (a loop of std::sqrt stays scalar: errno)
+#else
+  Lanes r;
+  for (std::size_t l = 0; l < lanes; ++l) r[l] = std::sqrt(x[l]);
+  return r;
+#endif
+}
+
 // atan2(s, c) for the bond's angles: below s/c = 0.05 (2.9 degrees, where bonds live) the odd
 // series x - x^3/3 + x^5/5 - x^7/7 of atan(s/c) is exact to 5e-12 relative and costs a tenth
-// of libm's atan2, which otherwise dominates the bond loop.
-inline double bond_angle(double s, double c) {
-  if (c > 0.0 && std::abs(s) < 0.05 * c) {
-    const double x = s / c, x2 = x * x;
-    return x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 * (1.0 / 7.0))));
-  }
-  return std::atan2(s, c);
+// of libm's atan2, which otherwise dominates the bond loop (and has no vector form here).
+inline Lanes bond_angle(Lanes s, Lanes c) {
+  const Lanes x = s / c, x2 = x * x;
+  Lanes angle = x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 * (1.0 / 7.0))));
+  const auto series = (c > 0.0) & ((s < 0.0 ? -s : s) < 0.05 * c);
+  for (std::size_t l = 0; l < lanes; ++l)
+    if (!series[l]) angle[l] = std::atan2(s[l], c[l]);  // a lane beyond the series (rare)
+  return angle;
 }
 
 // Rotation vector turning unit vector a onto unit vector b (exact for any angle, no loss near
-// 0 or pi/2).
-inline Vec3 rotation_between(const Vec3& a, const Vec3& b) {
-  const Vec3 axis = cross(a, b);
-  const double s = norm(axis);
-  if (s < 1e-300) return {};
-  return axis * (bond_angle(s, dot(a, b)) / s);
+// 0 or pi/2); zero where a and b are parallel to the last bit.
+inline LaneVec rotation_between(const LaneVec& a, const LaneVec& b) {
+  const LaneVec axis = cross(a, b);
+  const Lanes s = lane_sqrt(dot(axis, axis));
+  const LaneVec r = axis * (bond_angle(s, dot(a, b)) / s);
+  const auto parallel = s < 1e-300;
+  const Lanes zero{};
+  return {parallel ? zero : r.x, parallel ? zero : r.y, parallel ? zero : r.z};
 }
 
 // A unit vector perpendicular to d, chosen from the coordinate axis least aligned with d.
@@ -92,27 +143,45 @@ void BeamBondSet::scale_stiffness(std::span<const double> factor) {
 }
 
 BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
-  const std::uint32_t i = first_[b], j = second_[b];
-  const Quat& qi = p.orientation[i];
-  const Quat& qj = p.orientation[j];
   Actions a;
-  const Vec3 d = p.position[j] - p.position[i];
-  a.length = norm(d);
-  a.axis = d / a.length;
-  a.theta_a = rotation_between(a.axis, rotate(qi, direction_[b]));
-  a.theta_b = rotation_between(a.axis, rotate(qj, direction_[b]));
+  actions(b, 1, p, &a);
+  return a;
+}
+
+void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, Actions* out) const {
+  // Lane l holds bond first + l; lanes past count repeat the last bond (and are dropped).
+  LaneVec d, direction, normal;
+  LaneQuat qi, qj;
+  Lanes rest_length, axial, bending, torsion;
+  const auto put = [](LaneVec& v, std::size_t l, const Vec3& x) { v.x[l] = x.x, v.y[l] = x.y, v.z[l] = x.z; };
+  for (std::size_t l = 0; l < lanes; ++l) {
+    const std::size_t b = first + std::min(l, count - 1);
+    const std::uint32_t i = first_[b], j = second_[b];
+    put(d, l, p.position[j] - p.position[i]);
+    qi.w[l] = p.orientation[i].w, put(qi.v, l, p.orientation[i].v);
+    qj.w[l] = p.orientation[j].w, put(qj.v, l, p.orientation[j].v);
+    put(direction, l, direction_[b]);
+    put(normal, l, normal_[b]);
+    rest_length[l] = rest_length_[b], axial[l] = axial_[b], bending[l] = bending_[b], torsion[l] = torsion_[b];
+  }
+  const Lanes length = lane_sqrt(dot(d, d));
+  const LaneVec axis = d * (1.0 / length);
+  const LaneVec theta_a = rotation_between(axis, rotate(qi, direction));
+  const LaneVec theta_b = rotation_between(axis, rotate(qj, direction));
   // Twist about the axis between the two body-fixed copies of p0; the components of p
   // along the axis drop out of the triple product, only the cosine term needs them.
-  const Vec3 pi = rotate(qi, normal_[b]), pj = rotate(qj, normal_[b]);
-  a.twist = bond_angle(dot(a.axis, cross(pi, pj)), dot(pi, pj) - dot(pi, a.axis) * dot(pj, a.axis));
+  const LaneVec pi = rotate(qi, normal), pj = rotate(qj, normal);
+  const Lanes twist = bond_angle(dot(axis, cross(pi, pj)), dot(pi, pj) - dot(pi, axis) * dot(pj, axis));
 
-  a.axial_force = axial_[b] * (a.length - rest_length_[b]);
-  const double kb = bending_[b];
-  const double torsion_moment = torsion_[b] * a.twist;
-  a.torque_on_i = -kb * (2.0 * a.theta_a + a.theta_b) + torsion_moment * a.axis;
-  a.torque_on_j = -kb * (a.theta_a + 2.0 * a.theta_b) - torsion_moment * a.axis;
-  a.force_on_j = -a.axial_force * a.axis + cross(a.axis, a.torque_on_i + a.torque_on_j) / a.length;
-  return a;
+  const Lanes axial_force = axial * (length - rest_length);
+  const Lanes torsion_moment = torsion * twist;
+  const LaneVec torque_on_i = -bending * (2.0 * theta_a + theta_b) + torsion_moment * axis;
+  const LaneVec torque_on_j = -bending * (theta_a + 2.0 * theta_b) - torsion_moment * axis;
+  const LaneVec force_on_j = -axial_force * axis + cross(axis, torque_on_i + torque_on_j) * (1.0 / length);
+  const auto vec = [](const LaneVec& v, std::size_t l) { return Vec3{v.x[l], v.y[l], v.z[l]}; };
+  for (std::size_t l = 0; l < count; ++l)
+    out[l] = {length[l], axial_force[l], twist[l], vec(axis, l), vec(theta_a, l), vec(theta_b, l),
+              vec(force_on_j, l), vec(torque_on_i, l), vec(torque_on_j, l)};
 }
 
 void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
@@ -125,17 +194,25 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
   };
   const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
   if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
-    for_each_bond(colouring_, [&](std::size_t b) { add_actions(b, actions(b, p)); });
+    for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
+      Actions a[block];
+      actions(first, last - first, p, a);
+      for (std::size_t b = first; b < last; ++b) add_actions(b, a[b - first]);
+    });
     return;
   }
-  for_each_bond(colouring_, [&](std::size_t b) {
-    const Actions a = actions(b, p);
-    add_actions(b, a);
-    if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
-    if (energy) energy_record_[b] = energy_of(b, a);
-    // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
-    // scatters without races, in accumulate_virial's order.
-    if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
+  for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
+    Actions actions_of[block];
+    actions(first, last - first, p, actions_of);
+    for (std::size_t b = first; b < last; ++b) {
+      const Actions& a = actions_of[b - first];
+      add_actions(b, a);
+      if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
+      if (energy) energy_record_[b] = energy_of(b, a);
+      // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
+      // scatters without races, in accumulate_virial's order.
+      if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
+    }
   });
 }
 

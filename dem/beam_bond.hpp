@@ -67,6 +67,10 @@ class BeamBondSet final : public BondSet {
     Vec3 force_on_j, torque_on_i, torque_on_j;  // force on i is -force_on_j
   };
   Actions actions(std::size_t b, const ParticleSet& p) const;
+  // Bonds are evaluated `block` at a time (one per SIMD lane): actions of bonds
+  // [first, first + count), count in [1, block], into out[0, count).
+  static constexpr std::size_t block = 8;
+  void actions(std::size_t first, std::size_t count, const ParticleSet& p, Actions* out) const;
   const Parameters& parameters() const { return parameters_; }
 
  private:

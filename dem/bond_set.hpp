@@ -46,22 +46,30 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
   v.swap(sorted);
 }
 
-// Runs body(b) for every bond, colour by colour, each colour split over threads. One team of
-// threads serves all colours, with a barrier between colours, rather than a team started per
-// colour; it runs when the colours hold more than parallel_threshold_bonds bonds on average.
-// (The coupled wave bar's lattice, 6 colours of 174-387 bonds, 2 threads: 151-162 us per step
-// before, 150-154 us after, bench_coupled_step; its compare against the all-DEM bar 1.88-1.99x
-// before, 2.09-2.10x after; 2026-11-25.)
+// Runs body(first, last) over blocks of at most `block` consecutive bonds [first, last) of one
+// colour, colour by colour, each colour's blocks split over threads. One team of threads serves
+// all colours, with a barrier between colours, rather than a team started per colour; it runs
+// when the colours hold more than parallel_threshold_bonds bonds on average. (The coupled wave
+// bar's lattice, 6 colours of 174-387 bonds, 2 threads: 151-162 us per step before, 150-154 us
+// after, bench_coupled_step; its compare against the all-DEM bar 1.88-1.99x before, 2.09-2.10x
+// after; 2026-11-25.)
 template <class Body>
-void for_each_bond(const BondColouring& colouring, Body&& body) {
+void for_each_bond_block(const BondColouring& colouring, long block, Body&& body) {
   const long colours = static_cast<long>(colouring.offsets.size()) - 1;
   const long bonds = colours > 0 ? static_cast<long>(colouring.offsets.back()) : 0;
 #pragma omp parallel if (bonds > colours * parallel_threshold_bonds)
   for (long c = 0; c < colours; ++c) {
     const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
 #pragma omp for schedule(static)
-    for (long b = begin; b < end; ++b) body(static_cast<std::size_t>(b));
+    for (long k = begin; k < end; k += block)
+      body(static_cast<std::size_t>(k), static_cast<std::size_t>(std::min(end, k + block)));
   }
+}
+
+// Runs body(b) for every bond, as for_each_bond_block.
+template <class Body>
+void for_each_bond(const BondColouring& colouring, Body&& body) {
+  for_each_bond_block(colouring, 1, [&](std::size_t b, std::size_t) { body(b); });
 }
 
 // Adds the virial of a bond between DEs i and j, f_i the force on i, to both DEs. Per DE it is

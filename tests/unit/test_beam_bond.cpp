@@ -117,6 +117,46 @@ TEST_F(TwoDEs, EnergyIsThePotentialOfTheForces) {
   EXPECT_NEAR(-(e_plus - e_minus) / (2 * h), work_rate, 1e-4 * std::abs(work_rate));
 }
 
+// Bonds are evaluated BeamBondSet::block at a time, one per SIMD lane (a full block and a part
+// one here). Each lane is its own bond: a block gives the bits of each bond evaluated alone. Lanes
+// in the atan series (below 2.9 degrees), beyond it (atan2), and at exactly zero rotation each
+// give the end rotation that was imposed, about z.
+TEST(BeamBlock, EachLaneIsItsOwnBond) {
+  const double turns[] = {0.0, 1e-9, 1e-6, 0.01, 0.049, 0.051, 0.2, 1.0, 2.5, -0.3, -1e-3};  // rad
+  constexpr std::size_t n = std::size(turns);
+  static_assert(n > BeamBondSet::block && n < 2 * BeamBondSet::block);
+  ParticleSet p;
+  BeamBondSet beam{{R1Beam::E, R1Beam::nu, R1Beam::r_mu}};
+  for (std::size_t k = 0; k < n; ++k) {
+    p.add({0, 3.0 * k, 0}, R1Beam::R, 1.0);
+    p.add({R1Beam::L, 3.0 * k, 0}, R1Beam::R, 1.0);
+    beam.add(static_cast<std::uint32_t>(2 * k), static_cast<std::uint32_t>(2 * k + 1), p);
+  }
+  beam.finalize(p.size());
+  for (std::size_t k = 0; k < n; ++k) p.orientation[2 * k] = from_rotation_vector({0, 0, turns[k]});
+  BeamBondSet::Actions blocks[n];
+  beam.actions(0, BeamBondSet::block, p, blocks);
+  beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks + BeamBondSet::block);
+  for (std::size_t b = 0; b < n; ++b) {
+    const BeamBondSet::Actions alone = beam.actions(b, p), a = blocks[b];
+    EXPECT_EQ(a.length, alone.length) << b;
+    EXPECT_EQ(a.axial_force, alone.axial_force) << b;
+    EXPECT_EQ(a.twist, alone.twist) << b;
+    for (const auto& [x, y] : {std::pair{a.axis, alone.axis}, {a.theta_a, alone.theta_a}, {a.theta_b, alone.theta_b},
+                               {a.force_on_j, alone.force_on_j}, {a.torque_on_i, alone.torque_on_i},
+                               {a.torque_on_j, alone.torque_on_j}})
+      EXPECT_EQ(x, y) << b;
+    const double turn = turns[beam.first()[b] / 2];
+    EXPECT_NEAR(a.theta_a.z, turn, 5e-12 * std::abs(turn)) << b;  // the series: 5e-12 relative
+    EXPECT_EQ(a.theta_a.x, 0.0) << b;
+    EXPECT_EQ(a.theta_a.y, 0.0) << b;
+    EXPECT_EQ(norm(a.theta_b), 0.0) << b;
+    if (turn == 0.0) {
+      EXPECT_EQ(norm(a.torque_on_i), 0.0) << b;
+    }
+  }
+}
+
 // R1 chain: 10 bonds (20 mm), clamped, 0.01 N sideways at the tip, relaxed with viscous
 // damping: tip deflection P L^3/(3EI) = 5.432489e-3 mm and rotation P L^2/(2EI) =
 // 4.074367e-4 rad to 1e-4 (SI units here: the deflection is in m).
