@@ -126,6 +126,10 @@ class DemModel {
   // energy_limit (J), a blow-up.
   void check_finite() const;
   void check_energy(double energy_limit) const;
+  // The kinetic energy of every DE moving by one rounding error of its position (machine
+  // epsilon times the largest coordinate) per step of dt, J: the scale of round-off motion (the
+  // bond forces of a packing at rest are round-off, not zero, and the motion they cause grows).
+  double round_off_kinetic_energy(double dt) const;
 
  private:
   template <class Value>

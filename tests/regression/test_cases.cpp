@@ -400,6 +400,26 @@ TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
   EXPECT_TRUE(std::filesystem::exists(out / "fields.xdmf"));
 }
 
+// A step above the stability limit (forced past the input check) makes the energy grow
+// exponentially: the energy check stops the run as a blow-up, naming the step and the likely
+// cause, before any velocity is non-finite; the round-off floor of the check does not hide it.
+TEST(Runner, UnstableStepStopsTheRunAsABlowUp) {
+  const auto out = test::scratch_dir("blow_up");
+  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
+  scene.dt = 2.5 * scene.dt_critical;
+  app::RunOptions options;
+  options.max_steps = 5000;
+  try {
+    app::run_scene(scene, options);
+    FAIL() << "the run should have stopped";
+  } catch (const RunError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("exceeds the blow-up limit"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("likely cause: a time step too close to the stability limit"), std::string::npos) << msg;
+  }
+  EXPECT_EQ(Json::parse(test::read_text(out / "summary.json")).at("status").as_string(), "failed");
+}
+
 // Ctrl-C during the time loop: the run stops after the step it is in, closes every output as
 // after a failure (series.csv rows, fields.h5 renamed into place, summary.json "interrupted")
 // and throws Interrupted, which is not a RunError, so sweeps and suites do not carry on.
