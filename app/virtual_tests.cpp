@@ -801,7 +801,7 @@ void check_every_test(const std::filesystem::path& case_file, const SceneOptions
         }
     }
   }
-  std::printf("read the case of each test with its overrides before any run (%zu tests): %.1f s\n", checked,
+  std::printf("the case read with each test's overrides before any run: %zu reads, %.1f s\n", checked,
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
