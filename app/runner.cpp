@@ -339,13 +339,15 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const double initial_total = scene_total(model.energies(), continuum_energies(scene));
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
-  // the motion that boundary conditions impose. A scene at rest has round-off forces, and the
-  // motion they cause grows (a free packing: ~n^3 after n steps, 1e-31 J after 350 steps and
-  // 1e-27 J after 5600 in Runs.BondedPackingAtRestRunsToTheEnd): the scale after n steps is at
-  // least that of DEs whose positions gained a rounding error at each step, n^2 times the
-  // one-step round_off_kinetic_energy (4e-19 J there after 5600 steps).
+  // the motion that boundary conditions impose. A scene at rest has round-off forces (a bond's
+  // rest length is a computed distance), and the motion they cause grows (a free packing: 1e-31
+  // J after 350 steps, 1e-27 J after 5600 in Runs.BondedPackingAtRestRunsToTheEnd). Its scale:
+  // a stiffest spring k ~ m (2 / dt_c)^2 stretched by a rounding error of position eps X
+  // accelerates its DE by ~ eps X / dt_c^2, so after a time t the DEs move at ~ eps X t / dt_c^2;
+  // the energy scale is at least that motion's, round_off (eps X / dt_c) times (t / dt_c)^2
+  // (3e-21 J there after 5600 steps).
   double energy_scale = std::abs(initial_total);
-  const double round_off = model.round_off_kinetic_energy(scene.dt);
+  const double round_off = model.round_off_kinetic_energy(scene.dt_critical);
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
   // Float steps accumulate round-off: an output is due within a millionth of a step.
   const double slack = 1e-6 * scene.dt;
@@ -392,7 +394,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
       model.check_finite();
       if (n % 50 == 0 || n == total_steps)
-        model.check_energy(100.0 * (std::max(energy_scale, round_off * double(n) * double(n)) + std::abs(model.external_work())) +
+        model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
+                                    std::abs(model.external_work())) +
                            1e-300);
       if (output_after(n)) write_outputs();
       progress.update(n, current_time());

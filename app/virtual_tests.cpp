@@ -605,14 +605,23 @@ bool FailureStop::after_row(double stress, double strain) {
   return rows_below_ >= rows_needed_;
 }
 
+namespace {
+
+// InputError unless the case of a test to failure, as built for it, can break.
+void require_failure_criterion(const Scene& probe, const std::filesystem::path& case_file, const LoadCase& load) {
+  if (!probe.dem.failure_enabled())
+    throw InputError(case_file.string() + ": test " + load.name +
+                     " runs to failure but the case has no failure criterion (a bond law's sigma_f, or dem.failure.rdef)");
+}
+
+}  // namespace
+
 FailureTestResult run_failure_test(const std::filesystem::path& case_file, const SceneOptions& options, const LoadCase& load,
                                    const FailurePlan& plan) {
   if (load.shear()) throw InputError("test " + load.name + ": a test to failure is a tension test");
   const auto t0 = std::chrono::steady_clock::now();
   const TestSetup setup(case_file, options, load, plan.damping);
-  if (!setup.probe.dem.failure_enabled())
-    throw InputError(case_file.string() + ": test " + load.name +
-                     " runs to failure but the case has no failure criterion (a bond law's sigma_f, or dem.failure.rdef)");
+  require_failure_criterion(setup.probe, case_file, load);
   const SampleGeometry& g = setup.geometry;
   const int a = load.face;
   const double area = g.area(a), gauge = gauge_length(setup.probe.dem.particles, g, a);
@@ -771,11 +780,12 @@ std::string describe_failure(const FailureTestResult& r) {
 }
 
 // Every selected sample with every test, read as its run will read it (TestSetup's probe), before
-// any run: a bad override in a sample's or a test's set:, or a reference to a bond set the case
-// lacks, then stops the suite at once rather than when that test starts, maybe hours in. The
-// packings the runs load are built (and cached) here instead of at their first test.
+// any run: a bad override in a sample's or a test's set:, a test to failure whose case cannot
+// break, or a reference to a bond set the case lacks, then stops the suite at once rather than
+// when that test starts, maybe hours in. The packings the runs load are built (and cached) here
+// instead of at their first test.
 void check_every_test(const std::filesystem::path& case_file, const SceneOptions& options, const std::vector<SampleVariant>& samples,
-                      const std::vector<std::string>& only_samples, const std::vector<LoadCase>& tests,
+                      const std::vector<std::string>& only_samples, const std::vector<LoadCase>& tests, bool to_failure,
                       const std::vector<std::optional<FailureReference>>& references) {
   const auto t0 = std::chrono::steady_clock::now();
   std::size_t checked = 0;
@@ -786,6 +796,7 @@ void check_every_test(const std::filesystem::path& case_file, const SceneOptions
       o.check_output_dir = false;
       const Scene scene = build_scene(case_file, o);
       ++checked;
+      if (to_failure) require_failure_criterion(scene, case_file, tests[t]);
       if (t >= references.size() || !references[t]) continue;
       std::vector<std::string_view> sets;
       std::string listed;
@@ -908,7 +919,7 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
       if (!tests[i].modulus_estimate) tests[i].modulus_estimate = roles->estimate(i, theory);
   }
   root.finish();
-  check_every_test(case_file, options, samples, only_samples, tests, references);
+  check_every_test(case_file, options, samples, only_samples, tests, failure.has_value(), references);
   if (failure) return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, *failure);
 
   std::printf("virtual tests of %s: %s\n", case_file.string().c_str(), plan.describe().c_str());

@@ -1,6 +1,7 @@
 #include "dem/beam_bond.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -149,6 +150,7 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
 }
 
 void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, Actions* out) const {
+  assert(count >= 1 && count <= lanes);
   // Lane l holds bond first + l; lanes past count repeat the last bond (and are dropped).
   LaneVec d, direction, normal;
   LaneQuat qi, qj;

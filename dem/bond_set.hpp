@@ -57,7 +57,7 @@ template <class Body>
 void for_each_bond_block(const BondColouring& colouring, long block, Body&& body) {
   const long colours = static_cast<long>(colouring.offsets.size()) - 1;
   const long bonds = colours > 0 ? static_cast<long>(colouring.offsets.back()) : 0;
-#pragma omp parallel if (bonds > colours * parallel_threshold_bonds)
+#pragma omp parallel if (colours > 0 && bonds > colours * parallel_threshold_bonds)
   for (long c = 0; c < colours; ++c) {
     const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
 #pragma omp for schedule(static)

@@ -433,14 +433,14 @@ double DemModel::kinetic_energy() const {
   return e;
 }
 
-double DemModel::round_off_kinetic_energy(double dt) const {
+double DemModel::round_off_kinetic_energy(double time) const {
   double extent = 0.0, mass = 0.0;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const Vec3& x = particles.position[i];
     extent = std::max({extent, std::abs(x.x), std::abs(x.y), std::abs(x.z)});
     mass += particles.mass(i);
   }
-  const double speed = std::numeric_limits<double>::epsilon() * extent / dt;
+  const double speed = std::numeric_limits<double>::epsilon() * extent / time;
   return 0.5 * mass * speed * speed;
 }
 

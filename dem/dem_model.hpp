@@ -126,10 +126,10 @@ class DemModel {
   // energy_limit (J), a blow-up.
   void check_finite() const;
   void check_energy(double energy_limit) const;
-  // The kinetic energy of every DE moving by one rounding error of its position (machine
-  // epsilon times the largest coordinate) per step of dt, J: the scale of round-off motion (the
-  // bond forces of a packing at rest are round-off, not zero, and the motion they cause grows).
-  double round_off_kinetic_energy(double dt) const;
+  // The kinetic energy of every DE moving at eps X / time (eps: machine epsilon; X: the largest
+  // coordinate of any DE, so eps X is a rounding error of position), J. With time the critical
+  // step dt_c it is the scale of round-off motion (app/runner.cpp).
+  double round_off_kinetic_energy(double time) const;
 
  private:
   template <class Value>

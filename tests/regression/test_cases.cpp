@@ -402,7 +402,7 @@ TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
 
 // A step above the stability limit (forced past the input check) makes the energy grow
 // exponentially: the energy check stops the run as a blow-up, naming the step and the likely
-// cause, before any velocity is non-finite; the round-off floor of the check does not hide it.
+// cause, before any velocity is non-finite. (From rest: Runs.UnstableStepOnAPackingAtRestIsABlowUp.)
 TEST(Runner, UnstableStepStopsTheRunAsABlowUp) {
   const auto out = test::scratch_dir("blow_up");
   app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});

@@ -7,8 +7,10 @@
 #include <map>
 #include <sstream>
 
+#include "app/runner.hpp"
 #include "app/virtual_tests.hpp"
 #include "common/case_file.hpp"
+#include "common/error.hpp"
 #include "common/json.hpp"
 #include "support/cli.hpp"
 
@@ -149,6 +151,24 @@ TEST(Runs, BondedPackingAtRestRunsToTheEnd) {
   EXPECT_LT(summary.at("energies").at("kinetic").as_number(), 1e-24);
 }
 
+// The same packing at rest with a step above the stability limit (forced past the input check):
+// the round-off motion grows exponentially, and the energy check's first look (step 50) stops
+// it as a blow-up (~1e86 J against a limit of ~3e-21 J, the round-off floor), before any
+// velocity is non-finite.
+TEST(Runs, UnstableStepOnAPackingAtRestIsABlowUp) {
+  const auto dir = test::scratch_dir("packing_at_rest_unstable");
+  app::Scene scene = app::build_scene(homogeneous_case(dir), {.overrides = {}, .out_dir = dir / "out", .petsc_options = ""});
+  scene.dt = 3.0 * scene.dt_critical;  // the estimate is safe: at 1.5 x it ran without a blow-up
+  app::RunOptions options;
+  options.max_steps = 2000;
+  try {
+    app::run_scene(scene, options);
+    FAIL() << "the run should have stopped";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds the blow-up limit"), std::string::npos) << e.what();
+  }
+}
+
 // The overrides of a verify sample and of a failure target are read before the r_mu grid's
 // first run, not after it, as is the check that an RDEF target's case has no BBF strength.
 TEST(Calibration, VerifyAndTargetOverridesAreReadBeforeAnyRun) {
@@ -169,6 +189,16 @@ TEST(Calibration, VerifyAndTargetOverridesAreReadBeforeAnyRun) {
   r = test::run_arlequin(run);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("calibration.yaml:7: failure.targets[0].set: dem.failure.rdef.average=bonded_neighbour"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "curve")) << "a grid run started";
+  std::string bbf = test::read_text(dir / "sample.yaml");
+  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
+  write(dir / "bbf_case.yaml", bbf);
+  write(dir / "calibration.yaml", "case: bbf_case.yaml\nr_mu: [0.2, 0.3]\ntargets: [{name: epoxy, E: 3.45e9, nu: 0.3}]\n"
+                                  "failure:\n  targets: [{name: epoxy, criterion: rdef, stress: 7.0e7, reference: 1.48e8}]\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("has a BBF strength (sigma_f); the RDEF target 'epoxy' needs a case without one"), std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "curve")) << "a grid run started";
 }
@@ -351,7 +381,8 @@ TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
 }
 
 // Every sample with every test is read before the first run: a bad override of the second test,
-// or a reference to a bond set the case lacks, stops the suite before the first test runs.
+// a reference to a bond set the case lacks, or a test to failure whose case (with that test's
+// overrides) cannot break, stops the suite before the first test runs.
 TEST(VirtualTests, EveryTestIsReadBeforeTheFirstRuns) {
   const auto dir = test::scratch_dir("virtual_tests_early_overrides");
   homogeneous_case(dir);
@@ -363,14 +394,25 @@ TEST(VirtualTests, EveryTestIsReadBeforeTheFirstRuns) {
             std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
+  // A case that can break (BBF), so that test L would run to its end if the reference were not read first.
+  std::string bbf = test::read_text(dir / "sample.yaml");
+  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
+  write(dir / "bbf_case.yaml", bbf);
   write(dir / "spec.yaml",
-        "case: sample.yaml\nfailure: {expected_strain: 0.01}\ntests:\n  - {name: L, tension: z,\n"
+        "case: bbf_case.yaml\nfailure: {expected_strain: 0.01}\ntests:\n  - {name: L, tension: z,\n"
         "     reference: {name: seed, stress: [1.0e9, 2.0e9], strain: [0.01, 0.02], broken: {bond: [1, 2]}}}\n");
   r = test::run_arlequin(run);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("spec.yaml:5: tests[0].reference.broken.bond: the case has no bond set 'bond'; did you mean 'bonds'?"),
             std::string::npos)
       << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
+  write(dir / "spec.yaml",
+        "case: bbf_case.yaml\nfailure: {expected_strain: 0.01}\n"
+        "tests: [{name: L, tension: z}, {name: T, tension: x, set: [dem.bond.sigma_f=0]}]\n");
+  r = test::run_arlequin(run);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("test T runs to failure but the case has no failure criterion"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
 }
 

@@ -118,13 +118,16 @@ TEST_F(TwoDEs, EnergyIsThePotentialOfTheForces) {
 }
 
 // Bonds are evaluated BeamBondSet::block at a time, one per SIMD lane (a full block and a part
-// one here). Each lane is its own bond: a block gives the bits of each bond evaluated alone. Lanes
-// in the atan series (below 2.9 degrees), beyond it (atan2), and at exactly zero rotation each
-// give the end rotation that was imposed, about z.
+// one here). Each lane is its own bond: a block gives the bits of each bond evaluated alone. Each
+// lane has its own end rotation about z, twist about the axis and stretch, in the atan series
+// (below 2.9 degrees), beyond it (atan2) or exactly zero, and gives them back: the rotation, the
+// twist, and the axial force E S / L0 times the stretch.
 TEST(BeamBlock, EachLaneIsItsOwnBond) {
   const double turns[] = {0.0, 1e-9, 1e-6, 0.01, 0.049, 0.051, 0.2, 1.0, 2.5, -0.3, -1e-3};  // rad
+  const double twists[] = {0.3, 0.0, -1e-3, 2.0, 1e-7, -0.04, 0.06, 0.0, 1e-5, -1.2, 0.5};  // rad
   constexpr std::size_t n = std::size(turns);
-  static_assert(n > BeamBondSet::block && n < 2 * BeamBondSet::block);
+  static_assert(n > BeamBondSet::block && n < 2 * BeamBondSet::block && std::size(twists) == n);
+  const auto stretch = [](std::size_t k) { return 1e-5 * R1Beam::L * (double(k) - 4.0); };  // m
   ParticleSet p;
   BeamBondSet beam{{R1Beam::E, R1Beam::nu, R1Beam::r_mu}};
   for (std::size_t k = 0; k < n; ++k) {
@@ -133,7 +136,11 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
     beam.add(static_cast<std::uint32_t>(2 * k), static_cast<std::uint32_t>(2 * k + 1), p);
   }
   beam.finalize(p.size());
-  for (std::size_t k = 0; k < n; ++k) p.orientation[2 * k] = from_rotation_vector({0, 0, turns[k]});
+  for (std::size_t k = 0; k < n; ++k) {
+    p.orientation[2 * k] = from_rotation_vector({0, 0, turns[k]});
+    p.orientation[2 * k + 1] = from_rotation_vector({twists[k], 0, 0});
+    p.position[2 * k + 1].x += stretch(k);
+  }
   BeamBondSet::Actions blocks[n];
   beam.actions(0, BeamBondSet::block, p, blocks);
   beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks + BeamBondSet::block);
@@ -146,14 +153,13 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
                                {a.force_on_j, alone.force_on_j}, {a.torque_on_i, alone.torque_on_i},
                                {a.torque_on_j, alone.torque_on_j}})
       EXPECT_EQ(x, y) << b;
-    const double turn = turns[beam.first()[b] / 2];
-    EXPECT_NEAR(a.theta_a.z, turn, 5e-12 * std::abs(turn)) << b;  // the series: 5e-12 relative
+    const std::size_t k = beam.first()[b] / 2;
+    EXPECT_NEAR(a.theta_a.z, turns[k], 5e-12 * std::abs(turns[k])) << b;  // the series: 5e-12 relative
     EXPECT_EQ(a.theta_a.x, 0.0) << b;
     EXPECT_EQ(a.theta_a.y, 0.0) << b;
-    EXPECT_EQ(norm(a.theta_b), 0.0) << b;
-    if (turn == 0.0) {
-      EXPECT_EQ(norm(a.torque_on_i), 0.0) << b;
-    }
+    EXPECT_EQ(norm(a.theta_b), 0.0) << b;  // DE j turns about the bond's axis only
+    EXPECT_NEAR(a.twist, twists[k], 5e-12 * std::abs(twists[k]) + 1e-15) << b;
+    expect_relative(a.axial_force, R1Beam::E * R1Beam::S / R1Beam::L * stretch(k), 1e-9);
   }
 }
 
