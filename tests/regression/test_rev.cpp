@@ -34,6 +34,14 @@ std::filesystem::path homogeneous_case(const std::filesystem::path& dir) {
   return dir / "sample.yaml";
 }
 
+// homogeneous_case's packing with BBF bonds (sigma_f 2 GPa), written as dir/bbf_case.yaml.
+std::filesystem::path bbf_case(const std::filesystem::path& dir) {
+  std::string text = test::read_text(homogeneous_case(dir));
+  text.replace(text.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
+  write(dir / "bbf_case.yaml", text);
+  return dir / "bbf_case.yaml";
+}
+
 app::LoadCase load_case(const char* name, int face, int direction) {
   app::LoadCase load;
   load.name = name;
@@ -191,9 +199,7 @@ TEST(Calibration, VerifyAndTargetOverridesAreReadBeforeAnyRun) {
   EXPECT_NE(r.output.find("calibration.yaml:7: failure.targets[0].set: dem.failure.rdef.average=bonded_neighbour"), std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "curve")) << "a grid run started";
-  std::string bbf = test::read_text(dir / "sample.yaml");
-  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
-  write(dir / "bbf_case.yaml", bbf);
+  bbf_case(dir);
   write(dir / "calibration.yaml", "case: bbf_case.yaml\nr_mu: [0.2, 0.3]\ntargets: [{name: epoxy, E: 3.45e9, nu: 0.3}]\n"
                                   "failure:\n  targets: [{name: epoxy, criterion: rdef, stress: 7.0e7, reference: 1.48e8}]\n");
   r = test::run_arlequin(run);
@@ -263,9 +269,7 @@ TEST(Calibration, StrengthsReproduceTheTargetFailureStress) {
     EXPECT_NEAR(ratio / first[row.at("criterion")], 1.0, 0.25) << row.at("criterion") << " round " << row.at("round");
   }
 
-  std::string bbf = test::read_text(dir / "sample.yaml");
-  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
-  write(dir / "bbf_case.yaml", bbf);
+  bbf_case(dir);
   write(dir / "bad.yaml", "case: bbf_case.yaml\nfailure:\n  targets:\n" + targets.substr(targets.find("    - {name: epoxy, criterion: rdef")));
   const auto bad = test::run_arlequin("calibrate " + (dir / "bad.yaml").string() + " --out " + (dir / "bad").string());
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
@@ -395,9 +399,7 @@ TEST(VirtualTests, EveryTestIsReadBeforeTheFirstRuns) {
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "out" / "base" / "L")) << "test L ran";
   // A case that can break (BBF), so that test L would run to its end if the reference were not read first.
-  std::string bbf = test::read_text(dir / "sample.yaml");
-  bbf.replace(bbf.find("r_mu: 0.3}"), 10, "r_mu: 0.3, sigma_f: 2.0e9}");
-  write(dir / "bbf_case.yaml", bbf);
+  bbf_case(dir);
   write(dir / "spec.yaml",
         "case: bbf_case.yaml\nfailure: {expected_strain: 0.01}\ntests:\n  - {name: L, tension: z,\n"
         "     reference: {name: seed, stress: [1.0e9, 2.0e9], strain: [0.01, 0.02], broken: {bond: [1, 2]}}}\n");
