@@ -329,8 +329,7 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
 RunResult run_scene(Scene& scene, const RunOptions& options) {
   dem::DemModel& model = scene.dem;
   long total_steps = scene.steps;
-  // A static continuum alone: one solve, whatever --steps says.
-  const bool static_only = scene.continuum && scene.continuum->is_static() && model.particles.size() == 0;
+  const bool static_only = scene.static_only();  // one solve, whatever --steps says
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
   Outputs outputs(scene);

@@ -602,7 +602,6 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
     coupling->fail("overlap", "coupling needs both a dem and a continuum section");
   // The continuum first: a coupling's overlap cuts the DEM sample to its domain.
   if (continuum_node) scene.continuum = ContinuumPart::read(*continuum_node, coupling, options.petsc_options);
-  const bool static_only = !dem_node && scene.continuum->is_static();
   dem::DemModel& model = scene.dem;
   if (dem_node) {
     std::vector<std::string> materials;
@@ -640,6 +639,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (dem_node) read_boundary(root, model);
   finalize_dem(root, scene, coupling.has_value());
 
+  const bool static_only = scene.static_only();
   std::optional<CaseNode> time = static_only ? root.child_if("time") : root.child("time");
   scene.end_time = time ? time->number("end", Range::positive(), "s") : 1.0;
   const std::optional<double> user_dt = time ? time->number_or_auto("dt", Range::positive(), "s") : std::nullopt;

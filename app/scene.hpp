@@ -106,6 +106,9 @@ struct Scene {
   std::vector<Sensor> sensors;
   std::vector<Check> checks;
   OutputPlan output;
+
+  // A static continuum and no DE: one solve, no time stepping (time is optional).
+  bool static_only() const { return continuum && continuum->is_static() && dem.particles.size() == 0; }
 };
 
 struct SceneOptions {
