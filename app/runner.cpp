@@ -344,7 +344,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   // a stiffest spring k ~ m (2 / dt_c)^2 stretched by a rounding error of position eps X
   // accelerates its DE by ~ eps X / dt_c^2, so after a time t the DEs move at ~ eps X t / dt_c^2;
   // the energy scale is at least that motion's, round_off (eps X / dt_c) times (t / dt_c)^2
-  // (3e-21 J there after 5600 steps).
+  // (~4e-21 J there after 5600 steps).
   double energy_scale = std::abs(initial_total);
   const double round_off = model.round_off_kinetic_energy(scene.dt_critical);
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
