@@ -89,10 +89,6 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
       Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
   solver_->project(ad, ac, acc_d_, acc_c_, mu_);
-  gather_dem_velocity(vd_);
-  solver_->residual(vd_, continuum_velocity(), residual_);
-  update_monitor(residual_);
-  acceleration_norm_ = acceleration_norm();
 
   time_steps_.dem = dem_.critical_time_step();
   time_steps_.continuum = continuum_.critical_time_step();
@@ -138,7 +134,6 @@ void CoupledModel::step(double dt) {
   advance_models(dt);
   kick_to_trial(dt);
   solve_and_correct(dt);
-  account_energy(dt);
   time_ += dt;
   ++steps_;
 }
@@ -177,15 +172,6 @@ void CoupledModel::solve_and_correct(double dt) {
   mu_.swap(lambda_);
 }
 
-void CoupledModel::account_energy(double) {
-  acceleration_norm_ = acceleration_norm();
-  gather_dem_velocity(vd_);
-  solver_->residual(vd_, continuum_velocity(), residual_);
-  update_monitor(residual_);
-  const double scale = monitor_scale_;
-  monitor_.drift_residual = scale > 0 ? frobenius(drift_residual_) / scale : frobenius(drift_residual_);
-}
-
 // sum m |a|^2 with a the constrained accelerations (rotations included).
 std::array<double, 2> CoupledModel::acceleration_norm() const {
   const auto& P = dem_.particles;
@@ -209,24 +195,27 @@ std::array<double, 2> CoupledModel::acceleration_norm() const {
   return {sum, sum_c};
 }
 
-void CoupledModel::update_monitor(const Matrix3& residual_after) {
-  // |G_d vd|, the scale of both residuals (dd_ is free scratch here).
-  dd_.resize(ops_.rows(), 3);
-  dd_.noalias() = ops_.Gd * vd_;
-  monitor_scale_ = frobenius(dd_);
-  const double scale = monitor_scale_;
-  monitor_.constraint_residual = scale > 0 ? frobenius(residual_after) / scale : frobenius(residual_after);
-  mismatch_.noalias() = ops_.N * Eigen::Map<const Matrix3>(continuum_.velocity().data(), continuum_.num_nodes(), 3);
-  mismatch_ -= vd_;
-  const Eigen::Index n = mismatch_.rows();
+CouplingMonitor CoupledModel::monitor() const {
+  Matrix3 vd, residual;
+  gather_dem_velocity(vd);
+  const Eigen::Map<const Matrix3> vc(continuum_.velocity().data(), continuum_.num_nodes(), 3);
+  solver_->residual(vd, vc, residual);
+  const double scale = frobenius(ops_.Gd * vd);  // |G_d vd|, the scale of both residuals
+  const auto relative = [scale](const Matrix3& r) { return scale > 0 ? frobenius(r) / scale : frobenius(r); };
+  CouplingMonitor m;
+  m.constraint_residual = relative(residual);
+  m.drift_residual = relative(drift_residual_);
+  const Matrix3 mismatch = ops_.N * vc - vd;
+  const Eigen::Index n = mismatch.rows();
   double sum = 0.0, largest = 0.0;
   for (Eigen::Index p = 0; p < n; ++p) {
-    const double m2 = mismatch_.row(p).squaredNorm();
+    const double m2 = mismatch.row(p).squaredNorm();
     sum += m2;
     largest = std::max(largest, m2);
   }
-  monitor_.velocity_mismatch = n ? std::sqrt(sum / double(n)) : 0.0;
-  monitor_.max_velocity_mismatch = std::sqrt(largest);
+  m.velocity_mismatch = n ? std::sqrt(sum / double(n)) : 0.0;
+  m.max_velocity_mismatch = std::sqrt(largest);
+  return m;
 }
 
 CoupledEnergies CoupledModel::energies() const {
@@ -235,8 +224,9 @@ CoupledEnergies CoupledModel::energies() const {
   e.continuum_kinetic = continuum_.kinetic_energy();
   e.continuum_strain = continuum_.strain_energy();
   e.coupling_work = coupling_work_;
-  e.dem_acceleration_norm = acceleration_norm_[0];
-  e.continuum_acceleration_norm = acceleration_norm_[1];
+  const auto [dem_norm, continuum_norm] = acceleration_norm();
+  e.dem_acceleration_norm = dem_norm;
+  e.continuum_acceleration_norm = continuum_norm;
   return e;
 }
 

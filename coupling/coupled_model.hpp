@@ -24,8 +24,8 @@
 //      2. advance_models: DEM kick dt/2, drift, forces (weighted); continuum likewise
 //      3. kick_to_trial: both kick dt/2 -> trial velocities v*
 //      4. solve_multipliers: A lambda = G_d v_d* + G_c v_c*
-//      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt
-//      6. account_energy: coupling work, velocity mismatch
+//      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt, and the work
+//         of the multiplier forces
 //    Steps 3-5 are DESIGN.md section 2 steps 3-5; step 1 is the same constraint force applied
 //    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
 //  - critical_time_step() = min(DEM, continuum): the constrained system's highest frequency
@@ -110,7 +110,9 @@ class CoupledModel {
 
   CoupledEnergies energies() const;
   double coupling_work() const { return coupling_work_; }  // J, as in energies(), without the sums
-  const CouplingMonitor& monitor() const { return monitor_; }
+  // From the state after the last step, on demand (a step computes neither these nor the
+  // acceleration norms of energies(): the runner asks at output rows only).
+  CouplingMonitor monitor() const;
   // |G_d u_d + G_c u_c| / |G_d u_d| for the current displacements.
   double displacement_residual() const;
 
@@ -129,12 +131,10 @@ class CoupledModel {
   void advance_models(double dt);
   void kick_to_trial(double dt);
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
-  void account_energy(double dt);
 
   void gather_dem_velocity(Matrix3& v) const;
   void scatter_dem_velocity(const Matrix3& v);
   Eigen::Map<Matrix3> continuum_velocity();
-  void update_monitor(const Matrix3& residual_after);  // uses vd_ (the coupled DEs' velocities)
 
   dem::DemModel& dem_;
   continuum::ContinuumSolver& continuum_;
@@ -147,15 +147,12 @@ class CoupledModel {
   Matrix3 mu_;             // multipliers of the constraint force at t(n)
   Matrix3 drift_residual_;
   // Scratch of the step (sized once; no allocation per step): coupled DE velocities,
-  // multipliers, residual, corrections, velocity mismatch.
-  Matrix3 vd_, lambda_, residual_, dd_, dc_, mismatch_;
-  double monitor_scale_ = 0.0;  // |G_d vd| at the last monitor update
+  // multipliers, corrections.
+  Matrix3 vd_, lambda_, dd_, dc_;
   TimeSteps time_steps_;
-  CouplingMonitor monitor_;
   bool continuum_stiffness_floored_ = false;
   double coupling_work_ = 0.0;
-  std::array<double, 2> acceleration_norm_{};  // DEM, continuum
-  std::array<double, 2> acceleration_norm() const;
+  std::array<double, 2> acceleration_norm() const;  // DEM, continuum
   double time_ = 0.0;
   long steps_ = 0;
 };
