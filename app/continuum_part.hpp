@@ -74,6 +74,10 @@ class ContinuumPart {
   virtual bool is_coupled() const = 0;
   virtual std::string coupling_summary() const = 0;  // one line per item, printed at start
   virtual double coupling_work() const = 0;          // J, work of the multiplier forces
+  // After the last step (zeros when not coupled): the constraint residual |G_d v_d + G_c v_c| /
+  // |G_d v_d| (1), and the rms and largest velocity mismatch |v_p - (N v_c)(x_p)| over the
+  // coupled DEs (m/s).
+  virtual std::array<double, 3> coupling_monitor() const = 0;
   virtual bool is_static() const = 0;
   virtual double critical_time_step() const = 0;  // of the coupled system when coupled
   virtual void step(double dt) = 0;    // one explicit step (of both models when coupled)

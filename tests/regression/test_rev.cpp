@@ -50,41 +50,24 @@ app::LoadCase load_case(const char* name, int face, int direction) {
   return load;
 }
 
-// Rows of a CSV file as maps column -> text.
-std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path) {
-  std::istringstream in(test::read_text(path));
-  std::string line, cell;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  for (std::stringstream s(line); std::getline(s, cell, ',');) header.push_back(cell);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    auto& row = rows.emplace_back();
-    std::size_t k = 0;
-    for (std::stringstream s(line); std::getline(s, cell, ',') && k < header.size();) row[header[k++]] = cell;
-  }
-  return rows;
-}
-double number(const std::map<std::string, std::string>& row, const std::string& column) { return std::stod(row.at(column)); }
-
 // The engineering constants of a composite suite from its tests.csv rows of one sample.
 struct RevConstants {
   double E_L, E_T, nu_LT, nu_TT, G_LT, G_TT;
 };
 RevConstants rev_constants(const std::filesystem::path& tests_csv) {
   std::map<std::string, std::map<std::string, std::string>> by_test;
-  for (const auto& row : read_csv(tests_csv)) {
+  for (const auto& row : test::read_csv(tests_csv)) {
     EXPECT_EQ(row.at("status"), "ok") << row.at("test");
     by_test[row.at("test")] = row;
   }
   const auto& L = by_test.at("L");
   const auto& T = by_test.at("T");
-  return {number(L, "modulus"),
-          number(T, "modulus"),
-          0.5 * (number(L, "poisson_x") + number(L, "poisson_y")),
-          number(T, "poisson_y"),
-          number(by_test.at("LT"), "modulus"),
-          number(by_test.at("TT"), "modulus")};
+  return {test::number(L, "modulus"),
+          test::number(T, "modulus"),
+          0.5 * (test::number(L, "poisson_x") + test::number(L, "poisson_y")),
+          test::number(T, "poisson_y"),
+          test::number(by_test.at("LT"), "modulus"),
+          test::number(by_test.at("TT"), "modulus")};
 }
 
 // Tension along two axes and simple shear of a homogeneous packing: the moduli of an isotropic
@@ -229,7 +212,7 @@ TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   const double r_mu = pair.at("r_mu").as_number();
   EXPECT_GT(r_mu, 0.2);
   EXPECT_LT(r_mu, 0.4);
-  EXPECT_GE(read_csv(dir / "a" / "curve.csv").size(), 3u);
+  EXPECT_GE(test::read_csv(dir / "a" / "curve.csv").size(), 3u);
 
   const auto second = test::run_arlequin("calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "b").string(), "stdout");
   ASSERT_EQ(second.exit_code, 0) << second.output;
@@ -260,11 +243,11 @@ TEST(Calibration, StrengthsReproduceTheTargetFailureStress) {
     EXPECT_NEAR(s.at("failure_stress").as_number(), 7.0e7, 0.05 * 7.0e7) << s.at("criterion").as_string();
   }
   // Every round: stress / threshold within 25 % of the first round's (near proportionality).
-  const auto rounds = read_csv(dir / "out" / "strength.csv");
+  const auto rounds = test::read_csv(dir / "out" / "strength.csv");
   ASSERT_GE(rounds.size(), 3u);  // each criterion needed at least one update from the seed's value
   std::map<std::string, double> first;
   for (const auto& row : rounds) {
-    const double ratio = number(row, "failure_stress") / number(row, "threshold");
+    const double ratio = test::number(row, "failure_stress") / test::number(row, "threshold");
     if (!first.count(row.at("criterion"))) first[row.at("criterion")] = ratio;
     EXPECT_NEAR(ratio / first[row.at("criterion")], 1.0, 0.25) << row.at("criterion") << " round " << row.at("round");
   }
@@ -292,7 +275,7 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
   const std::string md = test::read_text(dir / "out" / "failure.md");
   EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_bbf | | 1.30-1.42 | 8.86-10.00 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_rdef | | 1.34-1.45 | 9.80-10.90 |"), std::string::npos) << md;
-  const auto rows = read_csv(dir / "out" / "failure.csv");
+  const auto rows = test::read_csv(dir / "out" / "failure.csv");
   ASSERT_EQ(rows.size(), 4u);  // L_bbf, L_rdef, L_rdef_averaged, L_rdef_laguerre
   for (const auto& row : rows) {
     const std::string test = row.at("test");
@@ -301,10 +284,10 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
     if (test == "L_bbf") {
       EXPECT_EQ(row.at("broke"), "1");
     }
-    EXPECT_LT(number(row, "final_stress"), 0.9 * number(row, "failure_stress")) << test;
-    EXPECT_NEAR(number(row, "failure_strain"), 9.6e-3, 3.0e-3) << test;
-    EXPECT_NEAR(number(row, "failure_stress"), 1.30e9, 0.3 * 1.30e9) << test;
-    EXPECT_GT(number(row, "fracture_energy"), 0.0) << test;
+    EXPECT_LT(test::number(row, "final_stress"), 0.9 * test::number(row, "failure_stress")) << test;
+    EXPECT_NEAR(test::number(row, "failure_strain"), 9.6e-3, 3.0e-3) << test;
+    EXPECT_NEAR(test::number(row, "failure_stress"), 1.30e9, 0.3 * 1.30e9) << test;
+    EXPECT_GT(test::number(row, "fracture_energy"), 0.0) << test;
     const auto run = dir / "out" / "rev_10k" / test;
     const Json j = Json::parse(test::read_text(run / "test.json"));
     for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GE(j.at("broken_at_end").at(set).as_number(), 0.0) << set;
@@ -450,7 +433,7 @@ TEST(RevElastic, ReducedRevGivesTheCompositeConstants) {
     EXPECT_GT(value, 0.8 * fem);
     EXPECT_LT(value, 1.75 * fem);
   }
-  for (const auto& row : read_csv(dir / "out" / "tests.csv")) EXPECT_LT(number(row, "force_imbalance"), 0.02) << row.at("test");
+  for (const auto& row : test::read_csv(dir / "out" / "tests.csv")) EXPECT_LT(test::number(row, "force_imbalance"), 0.02) << row.at("test");
 }
 
 // R2: the calibration of cases/rev_elastic (curve points are cached next to its sample, so a
@@ -491,15 +474,15 @@ TEST(ValidationRev, Rev40kFailureMatchesSeedTable4) {
                                     "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::map<std::string, std::map<std::string, std::string>> by_test;
-  for (const auto& row : read_csv(dir / "failure.csv")) by_test[row.at("test")] = row;
+  for (const auto& row : test::read_csv(dir / "failure.csv")) by_test[row.at("test")] = row;
   for (const char* test : {"L_bbf", "L_rdef"}) {
     const auto& row = by_test.at(test);
     EXPECT_EQ(row.at("status"), "ok") << test;
-    EXPECT_GE(number(row, "failure_stress"), 1.30e9) << test;
-    EXPECT_LE(number(row, "failure_stress"), 1.50e9) << test;
-    EXPECT_NEAR(number(row, "failure_strain"), 9.6e-3, 1.0e-3) << test;
+    EXPECT_GE(test::number(row, "failure_stress"), 1.30e9) << test;
+    EXPECT_LE(test::number(row, "failure_stress"), 1.50e9) << test;
+    EXPECT_NEAR(test::number(row, "failure_strain"), 9.6e-3, 1.0e-3) << test;
   }
-  EXPECT_GT(number(by_test.at("L_rdef"), "failure_strain"), number(by_test.at("L_bbf"), "failure_strain"));
+  EXPECT_GT(test::number(by_test.at("L_rdef"), "failure_strain"), test::number(by_test.at("L_bbf"), "failure_strain"));
 }
 
 // R3 on the 40k-DE REV: E_L within -5 % / +15 % of 135.06 GPa, nu_LT 0.29 +- 0.02, E_T, G_LT and

@@ -6,7 +6,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace arlequin::test {
 
@@ -39,6 +42,25 @@ inline std::filesystem::path scratch_dir(const std::string& name) {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// Rows of a CSV file as maps column -> text.
+inline std::vector<std::map<std::string, std::string>> read_csv(const std::filesystem::path& path) {
+  std::istringstream in(read_text(path));
+  std::string line, cell;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  for (std::stringstream s(line); std::getline(s, cell, ',');) header.push_back(cell);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    auto& row = rows.emplace_back();
+    std::size_t k = 0;
+    for (std::stringstream s(line); std::getline(s, cell, ',') && k < header.size();) row[header[k++]] = cell;
+  }
+  return rows;
+}
+inline double number(const std::map<std::string, std::string>& row, const std::string& column) {
+  return std::stod(row.at(column));
 }
 
 }  // namespace arlequin::test
