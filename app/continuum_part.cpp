@@ -94,7 +94,7 @@ class Part final : public ContinuumPart {
   }
   std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
   double coupling_work() const override { return coupled_ ? coupled_->coupling_work() : 0.0; }
-  std::array<double, 3> coupling_monitor() const override {
+  CouplingMonitorValues coupling_monitor() const override {
     if (!coupled_) return {};
     const coupling::CouplingMonitor m = coupled_->monitor();
     return {m.constraint_residual, m.velocity_mismatch, m.max_velocity_mismatch};

@@ -56,6 +56,12 @@ class ContinuumSolver;
 
 namespace arlequin::app {
 
+struct CouplingMonitorValues {
+  double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d|
+  double velocity_mismatch_rms = 0.0;  // over the coupled DEs of |v_p - (N v_c)(x_p)|, m/s
+  double velocity_mismatch_max = 0.0;  // m/s
+};
+
 class ContinuumPart {
  public:
   // Builds the continuum, cut by the coupling's overlap when `coupling` is given; InputError for
@@ -74,10 +80,9 @@ class ContinuumPart {
   virtual bool is_coupled() const = 0;
   virtual std::string coupling_summary() const = 0;  // one line per item, printed at start
   virtual double coupling_work() const = 0;          // J, work of the multiplier forces
-  // After the last step (zeros when not coupled): the constraint residual |G_d v_d + G_c v_c| /
-  // |G_d v_d| (1), and the rms and largest velocity mismatch |v_p - (N v_c)(x_p)| over the
-  // coupled DEs (m/s).
-  virtual std::array<double, 3> coupling_monitor() const = 0;
+  // The coupling's monitor after the last step (at t = 0: after the initial projection onto
+  // the constraint); zeros when not coupled.
+  virtual CouplingMonitorValues coupling_monitor() const = 0;
   virtual bool is_static() const = 0;
   virtual double critical_time_step() const = 0;  // of the coupled system when coupled
   virtual void step(double dt) = 0;    // one explicit step (of both models when coupled)

@@ -58,7 +58,7 @@ class Outputs {
     for (const char* c : energy_columns) columns.push_back(c);
     if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
     if (scene.continuum && scene.continuum->is_coupled())
-      columns.insert(columns.end(), {"W_coupling", "G_residual", "V_mismatch_rms", "V_mismatch_max"});
+      columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
     if (scene.dem.failure_enabled())
       for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
     series_.emplace(scene.output.dir / "series.csv", columns);
@@ -91,9 +91,10 @@ class Outputs {
     if (scene_.continuum) {
       row_.push_back(c.kinetic);
       row_.push_back(c.strain);
-      if (scene_.continuum->is_coupled()) {
-        row_.push_back(coupling_work(scene_));
-        for (double x : scene_.continuum->coupling_monitor()) row_.push_back(x);
+      if (scene_.continuum->is_coupled()) {  // coupling_columns
+        const CouplingMonitorValues m = scene_.continuum->coupling_monitor();
+        for (double x : {coupling_work(scene_), m.constraint_residual, m.velocity_mismatch_rms, m.velocity_mismatch_max})
+          row_.push_back(x);
       }
     }
     if (scene_.dem.failure_enabled()) {

@@ -690,7 +690,8 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_fracture", "E_total"});
   read_checks(root, scene, columns);
   // Plot columns: sensors, energies, time and the broken fractions.
-  columns.insert(columns.end(), {"time", "step", "E_balance", "C_kinetic", "C_strain", "W_coupling"});
+  columns.insert(columns.end(), {"time", "step", "E_balance", "C_kinetic", "C_strain"});
+  columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
   for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
   for (const PlotPlan& plot : scene.output.plots) {
     std::vector<std::string> used{plot.x};

@@ -121,6 +121,9 @@ struct SceneOptions {
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).
 std::vector<std::string> sensor_columns(const Scene& scene);
+// The columns series.csv adds for a coupled scene: the work of the multiplier forces (J) and
+// the coupling's monitor (ContinuumPart::coupling_monitor), in this order.
+inline constexpr const char* coupling_columns[] = {"W_coupling", "G_residual", "V_mismatch_rms", "V_mismatch_max"};
 
 // Throws InputError with file:line: key: message for any problem in the case.
 Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options);

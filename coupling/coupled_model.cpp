@@ -78,7 +78,8 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
 
   // Initial velocities onto the constraint.
   gather_dem_velocity(vd_);
-  solver_->project(vd_, continuum_velocity(), dd_, dc_, lambda_);
+  Matrix3 dd, dc;
+  solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);
   scatter_dem_velocity(vd_);
   // Constraint force at t = 0: the projection of the unconstrained accelerations.
   Matrix3 ad(np, 3);

@@ -25,7 +25,8 @@
 //      3. kick_to_trial: both kick dt/2 -> trial velocities v*
 //      4. solve_multipliers: A lambda = G_d v_d* + G_c v_c*
 //      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt, and the work
-//         of the multiplier forces
+//         of the multiplier forces over the drift (from the residual of the drift velocities
+//         of step 2)
 //    Steps 3-5 are DESIGN.md section 2 steps 3-5; step 1 is the same constraint force applied
 //    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
 //  - critical_time_step() = min(DEM, continuum): the constrained system's highest frequency
@@ -110,8 +111,8 @@ class CoupledModel {
 
   CoupledEnergies energies() const;
   double coupling_work() const { return coupling_work_; }  // J, as in energies(), without the sums
-  // From the state after the last step, on demand (a step computes neither these nor the
-  // acceleration norms of energies(): the runner asks at output rows only).
+  // From the state after the last step, on demand: a step computes neither this nor the
+  // acceleration norms of energies(), which only output rows and tests read.
   CouplingMonitor monitor() const;
   // |G_d u_d + G_c u_c| / |G_d u_d| for the current displacements.
   double displacement_residual() const;
@@ -134,6 +135,7 @@ class CoupledModel {
 
   void gather_dem_velocity(Matrix3& v) const;
   void scatter_dem_velocity(const Matrix3& v);
+  std::array<double, 2> acceleration_norm() const;  // DEM, continuum, for energies()
   Eigen::Map<Matrix3> continuum_velocity();
 
   dem::DemModel& dem_;
@@ -146,13 +148,12 @@ class CoupledModel {
   Matrix3 acc_d_, acc_c_;  // constraint accelerations M^-1 G^T mu(n) (subtracted)
   Matrix3 mu_;             // multipliers of the constraint force at t(n)
   Matrix3 drift_residual_;
-  // Scratch of the step (sized once; no allocation per step): coupled DE velocities,
-  // multipliers, corrections.
-  Matrix3 vd_, lambda_, dd_, dc_;
+  // Scratch of the step (sized once; no allocation per step): coupled DE velocities and
+  // multipliers.
+  Matrix3 vd_, lambda_;
   TimeSteps time_steps_;
   bool continuum_stiffness_floored_ = false;
   double coupling_work_ = 0.0;
-  std::array<double, 2> acceleration_norm() const;  // DEM, continuum
   double time_ = 0.0;
   long steps_ = 0;
 };

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <sstream>
 
 #include "app/runner.hpp"
 #include "app/virtual_tests.hpp"
