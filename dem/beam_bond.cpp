@@ -195,26 +195,27 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
     p.torque[j] += a.torque_on_j;
   };
   const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
-  if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
+  // Blocks of bonds: their actions, added, then record(b, a) for each bond.
+  const auto each_bond = [&](auto&& record) {
     for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
-      Actions a[block];
-      actions(first, last - first, p, a);
-      for (std::size_t b = first; b < last; ++b) add_actions(b, a[b - first]);
+      Actions actions_of[block];
+      actions(first, last - first, p, actions_of);
+      for (std::size_t b = first; b < last; ++b) {
+        add_actions(b, actions_of[b - first]);
+        record(b, actions_of[b - first]);
+      }
     });
+  };
+  if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
+    each_bond([](std::size_t, const Actions&) {});
     return;
   }
-  for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
-    Actions actions_of[block];
-    actions(first, last - first, p, actions_of);
-    for (std::size_t b = first; b < last; ++b) {
-      const Actions& a = actions_of[b - first];
-      add_actions(b, a);
-      if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
-      if (energy) energy_record_[b] = energy_of(b, a);
-      // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
-      // scatters without races, in accumulate_virial's order.
-      if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
-    }
+  each_bond([&](std::size_t b, const Actions& a) {
+    if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
+    if (energy) energy_record_[b] = energy_of(b, a);
+    // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
+    // scatters without races, in accumulate_virial's order.
+    if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
   });
 }
 
