@@ -236,7 +236,7 @@ void DemModel::drift(double dt) {
     p.position[i] += p.velocity[i] * dt;
     // Spheres: omega is constant over the drift, so the rotation is exact.
     if (norm2(p.angular_velocity[i]) > 0.0)
-      p.orientation[i] = normalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
+      p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
   }
 }
 
