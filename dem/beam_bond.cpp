@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <stdexcept>
 
@@ -58,27 +59,56 @@ inline Lanes lane_sqrt(Lanes x) {
 #endif
 }
 
-// atan2(s, c) for the bond's angles: below s/c = 0.05 (2.9 degrees, where bonds live) the odd
-// series x - x^3/3 + x^5/5 - x^7/7 of atan(s/c) is exact to 5e-12 relative and costs a tenth
-// of libm's atan2, which otherwise dominates the bond loop (and has no vector form here).
+// Eight quaternions (w, x, y, z) as one LaneQuat: a 4 x 8 transpose in two rounds of shuffles.
+static_assert(sizeof(Quat) == 4 * sizeof(double));
+using Quad = double __attribute__((vector_size(4 * sizeof(double))));
+inline LaneQuat transpose(const Quad (&q)[lanes]) {
+  // Pairs side by side: p[k] = (q[2k], q[2k+1]) = w x y z w x y z.
+  Lanes p[4];
+  for (int k = 0; k < 4; ++k) p[k] = __builtin_shufflevector(q[2 * k], q[2 * k + 1], 0, 1, 2, 3, 4, 5, 6, 7);
+  // Round 1: from two pairs, (w, x) and (y, z) of four quaternions.
+  const Lanes wx01 = __builtin_shufflevector(p[0], p[1], 0, 1, 4, 5, 8, 9, 12, 13);
+  const Lanes yz01 = __builtin_shufflevector(p[0], p[1], 2, 3, 6, 7, 10, 11, 14, 15);
+  const Lanes wx23 = __builtin_shufflevector(p[2], p[3], 0, 1, 4, 5, 8, 9, 12, 13);
+  const Lanes yz23 = __builtin_shufflevector(p[2], p[3], 2, 3, 6, 7, 10, 11, 14, 15);
+  // Round 2: every other element.
+  return {__builtin_shufflevector(wx01, wx23, 0, 2, 4, 6, 8, 10, 12, 14),
+          {__builtin_shufflevector(wx01, wx23, 1, 3, 5, 7, 9, 11, 13, 15),
+           __builtin_shufflevector(yz01, yz23, 0, 2, 4, 6, 8, 10, 12, 14),
+           __builtin_shufflevector(yz01, yz23, 1, 3, 5, 7, 9, 11, 13, 15)}};
+}
+
+// The odd series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
+// (2.9 degrees, where bonds live) it is exact to 5e-12 relative and costs a tenth of libm's
+// atan2, which otherwise dominates the bond loop (and has no vector form here).
+constexpr double series_limit = 0.05;
+inline Lanes atan_over_x(Lanes x2) { return 1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 * (1.0 / 7.0))); }
+
+// atan2(s, c), the twist angle.
 inline Lanes bond_angle(Lanes s, Lanes c) {
-  const Lanes x = s / c, x2 = x * x;
-  Lanes angle = x * (1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 5.0 - x2 * (1.0 / 7.0))));
-  const auto series = (c > 0.0) & ((s < 0.0 ? -s : s) < 0.05 * c);
+  const Lanes x = s / c;
+  Lanes angle = x * atan_over_x(x * x);
+  const auto series = (c > 0.0) & ((s < 0.0 ? -s : s) < series_limit * c);
   for (std::size_t l = 0; l < lanes; ++l)
     if (!series[l]) angle[l] = std::atan2(s[l], c[l]);  // a lane beyond the series (rare)
   return angle;
 }
 
 // Rotation vector turning unit vector a onto unit vector b (exact for any angle, no loss near
-// 0 or pi/2); zero where a and b are parallel to the last bit.
+// 0 or pi/2); zero where a and b are parallel to the last bit. With s = |a x b| and c = a.b it
+// is (a x b) atan2(s, c) / s; in the series' range atan(s/c)/s = atan_over_x(s^2/c^2) / c, so
+// neither s nor s/c is needed: one division, no square root.
 inline LaneVec rotation_between(const LaneVec& a, const LaneVec& b) {
   const LaneVec axis = cross(a, b);
-  const Lanes s = lane_sqrt(dot(axis, axis));
-  const LaneVec r = axis * (bond_angle(s, dot(a, b)) / s);
-  const auto parallel = s < 1e-300;
-  const Lanes zero{};
-  return {parallel ? zero : r.x, parallel ? zero : r.y, parallel ? zero : r.z};
+  const Lanes s2 = dot(axis, axis), c = dot(a, b), inverse_c = 1.0 / c;
+  Lanes scale = inverse_c * atan_over_x(s2 * inverse_c * inverse_c);
+  const auto series = (c > 0.0) & (s2 < (series_limit * series_limit) * (c * c));
+  for (std::size_t l = 0; l < lanes; ++l)
+    if (!series[l]) {  // beyond the series (rare)
+      const double s = std::sqrt(s2[l]);
+      scale[l] = s < 1e-300 ? 0.0 : std::atan2(s, c[l]) / s;
+    }
+  return axis * scale;
 }
 
 // A unit vector perpendicular to d, chosen from the coordinate axis least aligned with d.
@@ -119,8 +149,8 @@ void BeamBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
   axial_.push_back(parameters_.young * S / L0);
   bending_.push_back(2.0 * parameters_.young * I / L0);
   torsion_.push_back(G * J / L0);
-  direction_.push_back(d / L0);
-  normal_.push_back(perpendicular_to(d / L0));
+  const Vec3 direction = d / L0, normal = perpendicular_to(direction);
+  for (int k = 0; k < 3; ++k) direction_[k].push_back(direction[k]), normal_[k].push_back(normal[k]);
 }
 
 void BeamBondSet::finalize(std::size_t n_particles) {
@@ -130,8 +160,7 @@ void BeamBondSet::finalize(std::size_t n_particles) {
   apply_order(axial_, order);
   apply_order(bending_, order);
   apply_order(torsion_, order);
-  apply_order(direction_, order);
-  apply_order(normal_, order);
+  for (int k = 0; k < 3; ++k) apply_order(direction_[k], order), apply_order(normal_[k], order);
   failure_stress_.assign(size(), 0.0);
 }
 
@@ -144,28 +173,38 @@ void BeamBondSet::scale_stiffness(std::span<const double> factor) {
 }
 
 BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
-  Actions a;
-  actions(b, 1, p, &a);
-  return a;
+  ActionsBlock a;
+  actions(b, 1, p, a);
+  return a[0];
 }
 
-void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, Actions* out) const {
+void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const {
   assert(count >= 1 && count <= lanes);
   // Lane l holds bond first + l; lanes past count repeat the last bond (and are dropped).
-  LaneVec d, direction, normal;
-  LaneQuat qi, qj;
-  Lanes rest_length, axial, bending, torsion;
+  // The DEs' positions are gathered lane by lane, their orientations loaded whole and
+  // transposed; the bonds' own data, stored per component, are consecutive in a block and
+  // load as whole vectors.
+  LaneVec d;
+  Quad qa[lanes], qb[lanes];
   const auto put = [](LaneVec& v, std::size_t l, const Vec3& x) { v.x[l] = x.x, v.y[l] = x.y, v.z[l] = x.z; };
   for (std::size_t l = 0; l < lanes; ++l) {
     const std::size_t b = first + std::min(l, count - 1);
     const std::uint32_t i = first_[b], j = second_[b];
     put(d, l, p.position[j] - p.position[i]);
-    qi.w[l] = p.orientation[i].w, put(qi.v, l, p.orientation[i].v);
-    qj.w[l] = p.orientation[j].w, put(qj.v, l, p.orientation[j].v);
-    put(direction, l, direction_[b]);
-    put(normal, l, normal_[b]);
-    rest_length[l] = rest_length_[b], axial[l] = axial_[b], bending[l] = bending_[b], torsion[l] = torsion_[b];
+    std::memcpy(&qa[l], &p.orientation[i], sizeof(Quad));
+    std::memcpy(&qb[l], &p.orientation[j], sizeof(Quad));
   }
+  const LaneQuat qi = transpose(qa), qj = transpose(qb);
+  const auto load = [first, count](const std::vector<double>& data) {
+    Lanes v;
+    if (count == lanes) std::memcpy(&v, data.data() + first, sizeof v);
+    else
+      for (std::size_t l = 0; l < lanes; ++l) v[l] = data[first + std::min(l, count - 1)];
+    return v;
+  };
+  const LaneVec direction{load(direction_[0]), load(direction_[1]), load(direction_[2])};
+  const LaneVec normal{load(normal_[0]), load(normal_[1]), load(normal_[2])};
+  const Lanes rest_length = load(rest_length_), axial = load(axial_), bending = load(bending_), torsion = load(torsion_);
   const Lanes length = lane_sqrt(dot(d, d));
   const LaneVec axis = d * (1.0 / length);
   const LaneVec theta_a = rotation_between(axis, rotate(qi, direction));
@@ -180,37 +219,42 @@ void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSe
   const LaneVec torque_on_i = -bending * (2.0 * theta_a + theta_b) + torsion_moment * axis;
   const LaneVec torque_on_j = -bending * (theta_a + 2.0 * theta_b) - torsion_moment * axis;
   const LaneVec force_on_j = -axial_force * axis + cross(axis, torque_on_i + torque_on_j) * (1.0 / length);
-  const auto vec = [](const LaneVec& v, std::size_t l) { return Vec3{v.x[l], v.y[l], v.z[l]}; };
-  for (std::size_t l = 0; l < count; ++l)
-    out[l] = {length[l], axial_force[l], twist[l], vec(axis, l), vec(theta_a, l), vec(theta_b, l),
-              vec(force_on_j, l), vec(torque_on_i, l), vec(torque_on_j, l)};
+  const auto store = [](ActionsBlock::Lane& to, const Lanes& from) { std::memcpy(to, &from, sizeof from); };
+  const auto store_vec = [&store](ActionsBlock::Lane* to, const LaneVec& from) {
+    store(to[0], from.x), store(to[1], from.y), store(to[2], from.z);
+  };
+  store(out.length, length), store(out.axial_force, axial_force), store(out.twist, twist);
+  store_vec(out.axis, axis), store_vec(out.theta_a, theta_a), store_vec(out.theta_b, theta_b);
+  store_vec(out.force_on_j, force_on_j), store_vec(out.torque_on_i, torque_on_i), store_vec(out.torque_on_j, torque_on_j);
 }
 
 void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
-  const auto add_actions = [&p, this](std::size_t b, const Actions& a) {
+  const auto add_actions = [&p, this](std::size_t b, const ActionsBlock& a, std::size_t l) {
     const std::uint32_t i = first_[b], j = second_[b];
-    p.force[i] -= a.force_on_j;
-    p.force[j] += a.force_on_j;
-    p.torque[i] += a.torque_on_i;
-    p.torque[j] += a.torque_on_j;
+    const Vec3 force_on_j = ActionsBlock::at(a.force_on_j, l);
+    p.force[i] -= force_on_j;
+    p.force[j] += force_on_j;
+    p.torque[i] += ActionsBlock::at(a.torque_on_i, l);
+    p.torque[j] += ActionsBlock::at(a.torque_on_j, l);
   };
   const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
-  // Blocks of bonds: their actions, added, then record(b, a) for each bond.
+  // Blocks of bonds: their actions, added, then record(b, block's actions, lane) for each bond.
   const auto each_bond = [&](auto&& record) {
     for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
-      Actions actions_of[block];
+      ActionsBlock actions_of;
       actions(first, last - first, p, actions_of);
       for (std::size_t b = first; b < last; ++b) {
-        add_actions(b, actions_of[b - first]);
-        record(b, actions_of[b - first]);
+        add_actions(b, actions_of, b - first);
+        record(b, actions_of, b - first);
       }
     });
   };
   if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
-    each_bond([](std::size_t, const Actions&) {});
+    each_bond([](std::size_t, const ActionsBlock&, std::size_t) {});
     return;
   }
-  each_bond([&](std::size_t b, const Actions& a) {
+  each_bond([&](std::size_t b, const ActionsBlock& block_actions, std::size_t l) {
+    const Actions a = block_actions[l];
     if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
     if (energy) energy_record_[b] = energy_of(b, a);
     // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial

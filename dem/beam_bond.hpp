@@ -29,6 +29,8 @@
 // The dominant mode recorded is the largest of |N/S|, r_b|M|/I, V/S = 1.5 E r_b^2
 // |theta_a + theta_b| / L0^2 and the torsion stress G r_b |phi| / L0.
 #pragma once
+#include <array>
+
 #include "dem/bond_set.hpp"
 
 namespace arlequin::dem {
@@ -67,10 +69,23 @@ class BeamBondSet final : public BondSet {
     Vec3 force_on_j, torque_on_i, torque_on_j;  // force on i is -force_on_j
   };
   Actions actions(std::size_t b, const ParticleSet& p) const;
-  // Bonds are evaluated `block` at a time (one per SIMD lane): actions of bonds
-  // [first, first + count), count in [1, block], into out[0, count).
+  // Bonds are evaluated `block` at a time (one per SIMD lane), their actions kept as the
+  // kernel computes them, one array per quantity and component (stored whole, not lane by
+  // lane); out[l] is the Actions of the block's bond l.
   static constexpr std::size_t block = 8;
-  void actions(std::size_t first, std::size_t count, const ParticleSet& p, Actions* out) const;
+  struct ActionsBlock {
+    using Lane = double[block];
+    Lane length, axial_force, twist;
+    Lane axis[3], theta_a[3], theta_b[3], force_on_j[3], torque_on_i[3], torque_on_j[3];
+    static Vec3 at(const Lane (&v)[3], std::size_t l) { return {v[0][l], v[1][l], v[2][l]}; }
+    Actions operator[](std::size_t l) const {
+      return {length[l],         axial_force[l],       twist[l],
+              at(axis, l),       at(theta_a, l),       at(theta_b, l),
+              at(force_on_j, l), at(torque_on_i, l),   at(torque_on_j, l)};
+    }
+  };
+  // The actions of bonds [first, first + count), count in [1, block], into out[0, count).
+  void actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const;
   const Parameters& parameters() const { return parameters_; }
 
  private:
@@ -86,8 +101,10 @@ class BeamBondSet final : public BondSet {
   std::vector<double> axial_;         // E S / L0, N/m
   std::vector<double> bending_;       // 2 E I / L0, N m
   std::vector<double> torsion_;       // G J / L0, N m
-  std::vector<Vec3> direction_;       // d0 (reference axis), unit
-  std::vector<Vec3> normal_;          // p0 (perpendicular to d0), unit
+  // d0 (reference axis) and p0 (perpendicular to d0), unit: one array per component, so that
+  // a block of consecutive bonds loads each component as one vector, like the scalars above.
+  std::array<std::vector<double>, 3> direction_;
+  std::array<std::vector<double>, 3> normal_;
   // BBF's sigma per bond from the last force pass with ForceScan::criterion, Pa (scratch
   // sized by finalize, written by the force loop; one writer per bond).
   mutable std::vector<double> failure_stress_;

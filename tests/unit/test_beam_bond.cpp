@@ -141,11 +141,11 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
     p.orientation[2 * k + 1] = from_rotation_vector({twists[k], 0, 0});
     p.position[2 * k + 1].x += stretch(k);
   }
-  BeamBondSet::Actions blocks[n];
-  beam.actions(0, BeamBondSet::block, p, blocks);
-  beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks + BeamBondSet::block);
+  BeamBondSet::ActionsBlock blocks[2];
+  beam.actions(0, BeamBondSet::block, p, blocks[0]);
+  beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks[1]);
   for (std::size_t b = 0; b < n; ++b) {
-    const BeamBondSet::Actions alone = beam.actions(b, p), a = blocks[b];
+    const BeamBondSet::Actions alone = beam.actions(b, p), a = blocks[b / BeamBondSet::block][b % BeamBondSet::block];
     EXPECT_EQ(a.length, alone.length) << b;
     EXPECT_EQ(a.axial_force, alone.axial_force) << b;
     EXPECT_EQ(a.twist, alone.twist) << b;
