@@ -10,13 +10,20 @@ namespace arlequin {
 // Loops of at most this many items run on one thread: below it, starting threads costs more
 // than it saves.
 inline constexpr long parallel_threshold = 4096;
-// The same for bonds, per colour of a bond set on average (dem::for_each_bond). A bond costs
+// The same for bonds, per colour of a bond set on average (dem::BondColouring). A bond costs
 // 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
 // hundred to a few thousand bonds, which parallel_threshold kept on one thread (the 10k REV:
 // 3.3 ms per step on 2 threads against 1.8 ms at 512, 2026-11-25). 256, not 512, also puts the
-// ~330-bond colours of the coupled wave bar's lattice on threads (2 threads: 150 -> 131 us per
-// step; the 10k REV 1.62 -> 1.53 ms; bench_coupled_step and rev_elastic, alternated, 2026-11-25).
+// 10k REV's smaller sets on threads (2 threads, bench_bonded_block: 1.62 -> 1.53 ms, 2026-11-25;
+// with the faster bond kernel of 2026-11-26, 0.62-0.68 -> 0.54-0.56 ms).
 inline constexpr long parallel_threshold_bonds = 256;
+// ... and only in a scene of more DEs than this. Below it the DEs' state sits in one core's
+// cache, and a second thread moves more of it between the cores than it takes bonds off the
+// first: the coupled wave bar's lattice (775 DEs, 6 colours of ~330 bonds) steps in 60-67 us on
+// one thread and 73-81 us with its bonds on two; the all-DEM bar (2975 DEs, colours of ~1290)
+// gains from the second thread (0.129-0.143 -> 0.114-0.119 ms per step), as the 10k REV does
+// (bench_coupled_step, bench_bonded_block, 2026-11-26).
+inline constexpr long parallel_threshold_bond_particles = 2048;
 
 // sum over i < n of term(i), each term evaluated once (it may update state of item i): fixed
 // chunks of items are summed, on threads when n > threshold, then the chunks' sums are added

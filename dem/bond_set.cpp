@@ -31,6 +31,7 @@ std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> f
   offsets.assign(n_colours + 1, 0);
   for (std::size_t b = 0; b < n; ++b) ++offsets[colour[b] + 1];
   std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  threaded = long(n) > n_colours * parallel_threshold_bonds && long(n_particles) > parallel_threshold_bond_particles;
   return order;
 }
 

@@ -31,6 +31,9 @@ namespace arlequin::dem {
 // same for any thread count (results do not depend on OMP_NUM_THREADS).
 struct BondColouring {
   std::vector<std::uint32_t> offsets;  // colour k holds bonds [offsets[k], offsets[k+1])
+  // The colours run on threads: more than parallel_threshold_bonds bonds per colour on
+  // average, in a scene of more than parallel_threshold_bond_particles DEs (set by build).
+  bool threaded = false;
 
   // Greedy edge colouring of (first, second); returns the permutation that sorts bonds by
   // (colour, first) and fills offsets. Throws std::length_error beyond 64 colours.
@@ -47,17 +50,15 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
 }
 
 // Runs body(first, last) over blocks of at most `block` consecutive bonds [first, last) of one
-// colour, colour by colour, each colour's blocks split over threads. One team of threads serves
-// all colours, with a barrier between colours, rather than a team started per colour; it runs
-// when the colours hold more than parallel_threshold_bonds bonds on average. (The coupled wave
-// bar's lattice, 6 colours of 174-387 bonds, 2 threads: 151-162 us per step before, 150-154 us
-// after, bench_coupled_step; its compare against the all-DEM bar 1.88-1.99x before, 2.09-2.10x
-// after; 2026-11-25.)
+// colour, colour by colour, each colour's blocks split over threads if colouring.threaded. One
+// team of threads serves all colours, with a barrier between colours, rather than a team
+// started per colour (the coupled wave bar's lattice, 6 colours of 174-387 bonds, then on
+// threads, 2 threads: 151-162 us per step before, 150-154 us after, bench_coupled_step,
+// 2026-11-25).
 template <class Body>
 void for_each_bond_block(const BondColouring& colouring, long block, Body&& body) {
   const long colours = static_cast<long>(colouring.offsets.size()) - 1;
-  const long bonds = colours > 0 ? static_cast<long>(colouring.offsets.back()) : 0;
-#pragma omp parallel if (colours > 0 && bonds > colours * parallel_threshold_bonds)
+#pragma omp parallel if (colouring.threaded)
   for (long c = 0; c < colours; ++c) {
     const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
 #pragma omp for schedule(static)
@@ -149,6 +150,7 @@ class BondSet {
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }
   std::span<const std::uint32_t> second() const { return second_; }
+  bool runs_on_threads() const { return colouring_.threaded; }  // see BondColouring
   std::string name;  // the bonds' group (e.g. fibre, matrix, interface), for records and output
 
  protected:

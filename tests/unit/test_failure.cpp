@@ -262,9 +262,9 @@ TEST(ForceScan, RecordingLeavesTheForcesUnchanged) {
 }
 
 #ifdef _OPENMP
-// The force pass with a failure scan runs the colours' bonds on threads (more than
-// parallel_threshold_bonds per colour on average): forces, torques, BBF measures and virials are the same to the bit
-// on 1 and 2 threads, and so are the failures found.
+// The force pass with a failure scan runs the colours' bonds on threads (BondColouring):
+// forces, torques, BBF measures and virials are the same to the bit on 1 and 2 threads, and so
+// are the failures found.
 TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   DemModel model;
   const double R = 1e-3, a = 2 * R;
@@ -297,9 +297,7 @@ TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
     return out;
   };
   const Pass one = pass(1), two = pass(2);
-  // Colours large enough to go on threads: greedy colouring of a graph of degree 6 uses at most
-  // 11 colours for the 11 520 bonds.
-  EXPECT_GT(beam.size() / 11, std::size_t(parallel_threshold_bonds));
+  EXPECT_TRUE(beam.runs_on_threads());
   for (std::size_t i = 0; i < p.size(); ++i) {
     ASSERT_EQ(one.force[i], two.force[i]) << i;
     ASSERT_EQ(one.torque[i], two.torque[i]) << i;
@@ -338,6 +336,7 @@ TEST(ForceScan, BreakableStepsAreTheSameOnAnyThreadCount) {
     const test::OmpThreads scope(threads);
     DemModel model;
     const double dt = build_breakable_model(model, {17, 16, 16});  // above parallel_threshold DEs
+    for (const auto& set : model.bond_sets()) EXPECT_TRUE(set->runs_on_threads()) << set->law();
     for (int n = 0; n < 40; ++n) model.step(dt);
     return Run{model.particles.position, model.breaks(), model.energies()};
   };
