@@ -14,15 +14,17 @@ inline constexpr long parallel_threshold = 4096;
 // 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
 // hundred to a few thousand bonds, which parallel_threshold kept on one thread (the 10k REV:
 // 3.3 ms per step on 2 threads against 1.8 ms at 512, 2026-11-25). 256, not 512, also puts the
-// 10k REV's smaller sets on threads (2 threads, bench_bonded_block: 1.62 -> 1.53 ms, 2026-11-25;
-// with the faster bond kernel of 2026-11-26, 0.62-0.68 -> 0.54-0.56 ms).
+// 10k REV's smaller sets on threads (2 threads: 1.62 -> 1.53 ms per step, arlequin run
+// cases/rev_elastic, 2026-11-25; with the bond kernel of 2026-11-26, 0.62-0.68 -> 0.54-0.56 ms,
+// bench_bonded_block 200 cases/rev_elastic/case.yaml).
 inline constexpr long parallel_threshold_bonds = 256;
 // ... and only in a scene of more DEs than this. Below it the DEs' state sits in one core's
 // cache, and a second thread moves more of it between the cores than it takes bonds off the
-// first: the coupled wave bar's lattice (775 DEs, 6 colours of ~330 bonds) steps in 60-67 us on
-// one thread and 73-81 us with its bonds on two; the all-DEM bar (2975 DEs, colours of ~1290)
-// gains from the second thread (0.129-0.143 -> 0.114-0.119 ms per step), as the 10k REV does
-// (bench_coupled_step, bench_bonded_block, 2026-11-26).
+// first. The coupled wave bar's lattice (775 DEs, 6 colours of ~330 bonds), bench_coupled_step
+// on 2 threads, 2026-11-26: 60-67 us per step with its bonds on one thread against 73-81 us on
+// both (six alternations); a second set, twelve alternations, 61-86 us (median 76) against
+// 79-88 us (median 82). The all-DEM bar (2975 DEs, colours of ~1280 bonds) gains from the
+// second thread (0.129-0.143 -> 0.114-0.119 ms per step, bench_bonded_block), as the REVs do.
 inline constexpr long parallel_threshold_bond_particles = 2048;
 
 // sum over i < n of term(i), each term evaluated once (it may update state of item i): fixed

@@ -59,7 +59,8 @@ inline Lanes lane_sqrt(Lanes x) {
 #endif
 }
 
-// Eight quaternions (w, x, y, z) as one LaneQuat: a 4 x 8 transpose in two rounds of shuffles.
+// Eight quaternions (w, x, y, z) as one LaneQuat: a 4 x 8 transpose, shuffles only (pairs side
+// by side, then two rounds).
 static_assert(sizeof(Quat) == 4 * sizeof(double));
 using Quad = double __attribute__((vector_size(4 * sizeof(double))));
 inline LaneQuat transpose(const Quad (&q)[lanes]) {
@@ -78,7 +79,7 @@ inline LaneQuat transpose(const Quad (&q)[lanes]) {
            __builtin_shufflevector(yz01, yz23, 1, 3, 5, 7, 9, 11, 13, 15)}};
 }
 
-// The odd series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
+// The series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
 // (2.9 degrees, where bonds live) it is exact to 5e-12 relative and costs a tenth of libm's
 // atan2, which otherwise dominates the bond loop (and has no vector form here).
 constexpr double series_limit = 0.05;

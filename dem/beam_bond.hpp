@@ -84,7 +84,8 @@ class BeamBondSet final : public BondSet {
               at(force_on_j, l), at(torque_on_i, l),   at(torque_on_j, l)};
     }
   };
-  // The actions of bonds [first, first + count), count in [1, block], into out[0, count).
+  // The actions of bonds [first, first + count), count in [1, block], into lanes [0, count)
+  // of out (the lanes past count hold the last bond's again).
   void actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const;
   const Parameters& parameters() const { return parameters_; }
 

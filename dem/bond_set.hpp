@@ -35,8 +35,9 @@ struct BondColouring {
   // average, in a scene of more than parallel_threshold_bond_particles DEs (set by build).
   bool threaded = false;
 
-  // Greedy edge colouring of (first, second); returns the permutation that sorts bonds by
-  // (colour, first) and fills offsets. Throws std::length_error beyond 64 colours.
+  // Greedy edge colouring of (first, second) in a scene of n_particles DEs; returns the
+  // permutation that sorts bonds by (colour, first), fills offsets and sets threaded. Throws
+  // std::length_error beyond 64 colours.
   std::vector<std::uint32_t> build(std::span<const std::uint32_t> first,
                                    std::span<const std::uint32_t> second, std::size_t n_particles);
 };
@@ -150,7 +151,8 @@ class BondSet {
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }
   std::span<const std::uint32_t> second() const { return second_; }
-  bool runs_on_threads() const { return colouring_.threaded; }  // see BondColouring
+  // The force pass runs the colours on the OpenMP threads there are (BondColouring::threaded).
+  bool runs_on_threads() const { return colouring_.threaded; }
   std::string name;  // the bonds' group (e.g. fibre, matrix, interface), for records and output
 
  protected:
@@ -171,11 +173,12 @@ class BondSet {
     return order;
   }
   // record_energies(): energy_record_[b] = bond_energy(b) for every bond (finalized or not:
-  // each bond writes only its own entry, so no colouring is needed).
+  // each bond writes only its own entry, so no colouring is needed; on threads when the force
+  // pass is, by the same scene-size rule).
   template <class BondEnergy>
   void record_each(BondEnergy&& bond_energy) const {
     const long n = static_cast<long>(size());
-#pragma omp parallel for schedule(static) if (n > parallel_threshold_bonds)
+#pragma omp parallel for schedule(static) if (colouring_.threaded)
     for (long b = 0; b < n; ++b) energy_record_[b] = bond_energy(static_cast<std::size_t>(b));
   }
   virtual void zero_stiffness(std::size_t b) = 0;

@@ -118,28 +118,33 @@ TEST_F(TwoDEs, EnergyIsThePotentialOfTheForces) {
 }
 
 // Bonds are evaluated BeamBondSet::block at a time, one per SIMD lane (a full block and a part
-// one here). Each lane is its own bond: a block gives the bits of each bond evaluated alone. Each
-// lane has its own end rotation about z, twist about the axis and stretch, in the atan series
-// (below 2.9 degrees), beyond it (atan2) or exactly zero, and gives them back: the rotation, the
-// twist, and the axial force E S / L0 times the stretch.
+// one here). Each lane is its own bond: a block gives the bits of each bond evaluated alone.
+// Each lane has its own rest length and direction (in the xz-plane, so its reference normal
+// p0 is (-sin phi, 0, cos phi)), its own end rotation about p0, twist about the axis and
+// stretch, in the atan series (below 2.9 degrees), beyond it (atan2) or exactly zero, and gives
+// them back: the rotation, the twist, and the axial force E S / L0 times the stretch.
 TEST(BeamBlock, EachLaneIsItsOwnBond) {
   const double turns[] = {0.0, 1e-9, 1e-6, 0.01, 0.049, 0.051, 0.2, 1.0, 2.5, -0.3, -1e-3};  // rad
   const double twists[] = {0.3, 0.0, -1e-3, 2.0, 1e-7, -0.04, 0.06, 0.0, 1e-5, -1.2, 0.5};  // rad
   constexpr std::size_t n = std::size(turns);
   static_assert(n > BeamBondSet::block && n < 2 * BeamBondSet::block && std::size(twists) == n);
+  const auto rest_length = [](std::size_t k) { return R1Beam::L * (1.0 + 0.05 * double(k)); };
+  const auto phi = [](std::size_t k) { return 0.2 * double(k) - 1.0; };  // rad, from the x axis
+  const auto direction = [&](std::size_t k) { return Vec3{std::cos(phi(k)), 0.0, std::sin(phi(k))}; };
+  const auto normal = [&](std::size_t k) { return Vec3{-std::sin(phi(k)), 0.0, std::cos(phi(k))}; };
   const auto stretch = [](std::size_t k) { return 1e-5 * R1Beam::L * (double(k) - 4.0); };  // m
   ParticleSet p;
   BeamBondSet beam{{R1Beam::E, R1Beam::nu, R1Beam::r_mu}};
   for (std::size_t k = 0; k < n; ++k) {
     p.add({0, 3.0 * k, 0}, R1Beam::R, 1.0);
-    p.add({R1Beam::L, 3.0 * k, 0}, R1Beam::R, 1.0);
+    p.add(Vec3{0, 3.0 * k, 0} + direction(k) * rest_length(k), R1Beam::R, 1.0);
     beam.add(static_cast<std::uint32_t>(2 * k), static_cast<std::uint32_t>(2 * k + 1), p);
   }
   beam.finalize(p.size());
   for (std::size_t k = 0; k < n; ++k) {
-    p.orientation[2 * k] = from_rotation_vector({0, 0, turns[k]});
-    p.orientation[2 * k + 1] = from_rotation_vector({twists[k], 0, 0});
-    p.position[2 * k + 1].x += stretch(k);
+    p.orientation[2 * k] = from_rotation_vector(normal(k) * turns[k]);
+    p.orientation[2 * k + 1] = from_rotation_vector(direction(k) * twists[k]);
+    p.position[2 * k + 1] += direction(k) * stretch(k);
   }
   BeamBondSet::ActionsBlock blocks[2];
   beam.actions(0, BeamBondSet::block, p, blocks[0]);
@@ -154,12 +159,12 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
                                {a.torque_on_j, alone.torque_on_j}})
       EXPECT_EQ(x, y) << b;
     const std::size_t k = beam.first()[b] / 2;
-    EXPECT_NEAR(a.theta_a.z, turns[k], 5e-12 * std::abs(turns[k])) << b;  // the series: 5e-12 relative
-    EXPECT_EQ(a.theta_a.x, 0.0) << b;
-    EXPECT_EQ(a.theta_a.y, 0.0) << b;
-    EXPECT_EQ(norm(a.theta_b), 0.0) << b;  // DE j turns about the bond's axis only
+    // DE i turned about p0: theta_a along p0 (the series: 5e-12 relative); DE j about the axis.
+    EXPECT_NEAR(dot(a.theta_a, normal(k)), turns[k], 5e-12 * std::abs(turns[k]) + 1e-15) << b;
+    EXPECT_LT(norm(cross(a.theta_a, normal(k))), 1e-15 * (1.0 + std::abs(turns[k]))) << b;
+    EXPECT_LT(norm(a.theta_b), 1e-15) << b;
     EXPECT_NEAR(a.twist, twists[k], 5e-12 * std::abs(twists[k]) + 1e-15) << b;
-    expect_relative(a.axial_force, R1Beam::E * R1Beam::S / R1Beam::L * stretch(k), 1e-9);
+    expect_relative(a.axial_force, R1Beam::E * R1Beam::S / rest_length(k) * stretch(k), 1e-9);
   }
 }
 

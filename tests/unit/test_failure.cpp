@@ -261,6 +261,24 @@ TEST(ForceScan, RecordingLeavesTheForcesUnchanged) {
   }
 }
 
+// A bond set's colours go on threads with more than parallel_threshold_bonds bonds per colour
+// on average, in a scene of more than parallel_threshold_bond_particles DEs.
+TEST(BondColouring, ThreadsOnlyForLargeColoursInLargeScenes) {
+  const auto chain_on_threads = [](std::uint32_t bonds, std::size_t scene_particles) {
+    std::vector<std::uint32_t> first, second;  // a chain: two colours
+    for (std::uint32_t i = 0; i < bonds; ++i) first.push_back(i), second.push_back(i + 1);
+    BondColouring colouring;
+    colouring.build(first, second, scene_particles);
+    EXPECT_EQ(colouring.offsets.size(), 3u);
+    return colouring.threaded;
+  };
+  const auto large_colours = static_cast<std::uint32_t>(2 * parallel_threshold_bonds + 1);
+  const auto large_scene = static_cast<std::size_t>(parallel_threshold_bond_particles + 1);
+  EXPECT_TRUE(chain_on_threads(large_colours, large_scene));
+  EXPECT_FALSE(chain_on_threads(large_colours, large_scene - 1));
+  EXPECT_FALSE(chain_on_threads(large_colours - 1, 10 * large_scene));
+}
+
 #ifdef _OPENMP
 // The force pass with a failure scan runs the colours' bonds on threads (BondColouring):
 // forces, torques, BBF measures and virials are the same to the bit on 1 and 2 threads, and so
