@@ -27,6 +27,31 @@ inline constexpr long parallel_threshold_bonds = 256;
 // second thread (0.129-0.143 -> 0.114-0.119 ms per step, bench_bonded_block), as the REVs do.
 inline constexpr long parallel_threshold_bond_particles = 2048;
 
+// Runs loop() on the OpenMP threads if `threaded`, else in the calling thread; loop() holds
+// orphaned `omp for` loops, which split over the team inside the region and run whole outside
+// it. Not entering OpenMP at all is the point: a parallel region whose `if` clause is false
+// still starts a team of one, ~1.2 us each with GCC 12's libgomp on the 2-core VM (a 10-line
+// program, 2026-11-26), where an orphaned loop outside any region costs ~8 ns: several such
+// regions a step were ~10 % of the coupled wave bar's step.
+template <class Loop>
+void run_threaded_if(bool threaded, Loop&& loop) {
+  if (threaded) {
+#pragma omp parallel
+    loop();
+  } else {
+    loop();
+  }
+}
+
+// body(i) for i in [0, n), split statically over the OpenMP threads if `threaded`.
+template <class Body>
+void for_each_index(long n, bool threaded, Body&& body) {
+  run_threaded_if(threaded, [n, &body] {
+#pragma omp for schedule(static)
+    for (long i = 0; i < n; ++i) body(i);
+  });
+}
+
 // sum over i < n of term(i), each term evaluated once (it may update state of item i): fixed
 // chunks of items are summed, on threads when n > threshold, then the chunks' sums are added
 // in order, so the result has the same bits on any thread count (an OpenMP reduction's does
@@ -36,12 +61,11 @@ double fixed_order_sum(long n, long threshold, std::vector<double>& partial, Ter
   constexpr long chunk = 1024;
   const long chunks = (n + chunk - 1) / chunk;
   if (static_cast<long>(partial.size()) < chunks) partial.resize(static_cast<std::size_t>(chunks));
-#pragma omp parallel for schedule(static) if (n > threshold)
-  for (long c = 0; c < chunks; ++c) {
+  for_each_index(chunks, n > threshold, [&](long c) {
     double sum = 0.0;
     for (long i = c * chunk, end = std::min(n, (c + 1) * chunk); i < end; ++i) sum += term(i);
     partial[static_cast<std::size_t>(c)] = sum;
-  }
+  });
   double total = 0.0;
   for (long c = 0; c < chunks; ++c) total += partial[static_cast<std::size_t>(c)];
   return total;

@@ -40,8 +40,7 @@ void BlockMatrix3::multiply(const std::vector<double>& x, std::vector<double>& y
   if (&x == &y) throw std::invalid_argument("BlockMatrix3::multiply: x and y must differ");
   y.resize(x.size());
   const long n = rows();
-#pragma omp parallel for schedule(static) if (static_cast<long>(column_.size()) > parallel_threshold)
-  for (long i = 0; i < n; ++i) {
+  for_each_index(n, static_cast<long>(column_.size()) > parallel_threshold, [&](long i) {
     double y0 = 0.0, y1 = 0.0, y2 = 0.0;
     for (int k = offset_[i]; k < offset_[i + 1]; ++k) {
       const Block& b = block_[k];
@@ -53,7 +52,7 @@ void BlockMatrix3::multiply(const std::vector<double>& x, std::vector<double>& y
     y[3 * i] = y0;
     y[3 * i + 1] = y1;
     y[3 * i + 2] = y2;
-  }
+  });
 }
 
 }  // namespace arlequin::continuum

@@ -59,13 +59,14 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
 template <class Body>
 void for_each_bond_block(const BondColouring& colouring, long block, Body&& body) {
   const long colours = static_cast<long>(colouring.offsets.size()) - 1;
-#pragma omp parallel if (colouring.threaded)
-  for (long c = 0; c < colours; ++c) {
-    const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
+  run_threaded_if(colouring.threaded, [&] {
+    for (long c = 0; c < colours; ++c) {
+      const long begin = colouring.offsets[c], end = colouring.offsets[c + 1];
 #pragma omp for schedule(static)
-    for (long k = begin; k < end; k += block)
-      body(static_cast<std::size_t>(k), static_cast<std::size_t>(std::min(end, k + block)));
-  }
+      for (long k = begin; k < end; k += block)
+        body(static_cast<std::size_t>(k), static_cast<std::size_t>(std::min(end, k + block)));
+    }
+  });
 }
 
 // Runs body(b) for every bond, as for_each_bond_block.
@@ -177,9 +178,8 @@ class BondSet {
   // pass is, by the same scene-size rule).
   template <class BondEnergy>
   void record_each(BondEnergy&& bond_energy) const {
-    const long n = static_cast<long>(size());
-#pragma omp parallel for schedule(static) if (colouring_.threaded)
-    for (long b = 0; b < n; ++b) energy_record_[b] = bond_energy(static_cast<std::size_t>(b));
+    for_each_index(static_cast<long>(size()), colouring_.threaded,
+                   [&](long b) { energy_record_[b] = bond_energy(static_cast<std::size_t>(b)); });
   }
   virtual void zero_stiffness(std::size_t b) = 0;
 

@@ -194,16 +194,21 @@ void DemModel::apply_arlequin_weight(const std::function<double(const Vec3&)>& a
 void DemModel::kick(double half_dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-  // A half kick changes a DE's kinetic energy by h F . (v + v')/2 exactly; the damping
-  // force's share of that is the energy it dissipated.
-  const bool damping = damping_ > 0.0;
-  dissipated_ += fixed_order_sum(n, parallel_threshold, kick_partial_, [&](long i) {
-    const Vec3 v = p.velocity[i], w = p.angular_velocity[i];
+  const auto kick_one = [&p, half_dt](long i) {
     p.velocity[i] += p.force[i] * (half_dt * p.inv_mass[i]);
     p.angular_velocity[i] += p.torque[i] * (half_dt * p.inv_inertia(i));
-    return damping ? -half_dt * (dot(damping_force_[i], 0.5 * (v + p.velocity[i])) +
-                                 dot(damping_torque_[i], 0.5 * (w + p.angular_velocity[i])))
-                   : 0.0;
+  };
+  if (!(damping_ > 0.0)) {  // no damping work to account for: a plain loop
+    for_each_index(n, n > parallel_threshold, kick_one);
+    return;
+  }
+  // A half kick changes a DE's kinetic energy by h F . (v + v')/2 exactly; the damping
+  // force's share of that is the energy it dissipated.
+  dissipated_ += fixed_order_sum(n, parallel_threshold, kick_partial_, [&](long i) {
+    const Vec3 v = p.velocity[i], w = p.angular_velocity[i];
+    kick_one(i);
+    return -half_dt * (dot(damping_force_[i], 0.5 * (v + p.velocity[i])) +
+                       dot(damping_torque_[i], 0.5 * (w + p.angular_velocity[i])));
   });
 }
 
@@ -231,13 +236,12 @@ double DemModel::driven_kinetic_energy() const {
 void DemModel::drift(double dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-#pragma omp parallel for schedule(static) if (n > parallel_threshold)
-  for (long i = 0; i < n; ++i) {
+  for_each_index(n, n > parallel_threshold, [&p, dt](long i) {
     p.position[i] += p.velocity[i] * dt;
     // Spheres: omega is constant over the drift, so the rotation is exact.
     if (norm2(p.angular_velocity[i]) > 0.0)
       p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
-  }
+  });
 }
 
 void DemModel::update_neighbours() {
