@@ -32,7 +32,8 @@ inline constexpr long parallel_threshold_bond_particles = 2048;
 // it. Not entering OpenMP at all is the point: a parallel region whose `if` clause is false
 // still starts a team of one, ~1.2 us each with GCC 12's libgomp on the 2-core VM (a 10-line
 // program, 2026-11-26), where an orphaned loop outside any region costs ~8 ns: several such
-// regions a step were ~10 % of the coupled wave bar's step.
+// regions a step were a third of the coupled wave bar's step. Not for use inside a parallel
+// region: an orphaned loop there would split over the enclosing team (none of ours nests).
 template <class Loop>
 void run_threaded_if(bool threaded, Loop&& loop) {
   if (threaded) {
