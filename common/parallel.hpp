@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <vector>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace arlequin {
 
@@ -27,21 +30,24 @@ inline constexpr long parallel_threshold_bonds = 256;
 // second thread (0.129-0.143 -> 0.114-0.119 ms per step, bench_bonded_block), as the REVs do.
 inline constexpr long parallel_threshold_bond_particles = 2048;
 
-// Runs loop() on the OpenMP threads if `threaded`, else in the calling thread; loop() holds
-// orphaned `omp for` loops, which split over the team inside the region and run whole outside
-// it. Not entering OpenMP at all is the point: a parallel region whose `if` clause is false
-// still starts a team of one, ~1.2 us each with GCC 12's libgomp on the 2-core VM (a 10-line
-// program, 2026-11-26), where an orphaned loop outside any region costs ~8 ns: several such
-// regions a step were a third of the coupled wave bar's step. Not for use inside a parallel
-// region: an orphaned loop there would split over the enclosing team (none of ours nests).
+// Runs loop() on the OpenMP threads if `threaded` and there is more than one, else in the
+// calling thread; loop() holds orphaned `omp for` loops, which split over the team inside the
+// region and run whole outside it. Not entering OpenMP at all is the point: a parallel region
+// whose `if` clause is false still starts a team of one, ~1.2 us each with GCC 12's libgomp on
+// the 2-core VM (bench_omp_regions), where an orphaned loop outside any region costs ~8 ns;
+// the coupled wave bar's five such regions a step cost it ~22 us of 66 (2026-11-26). Not for
+// use inside a parallel region: an orphaned loop there would split over the enclosing team, or
+// hang if only some of its threads reach it (none of ours nests).
 template <class Loop>
 void run_threaded_if(bool threaded, Loop&& loop) {
-  if (threaded) {
+#ifdef _OPENMP
+  if (threaded && omp_get_max_threads() > 1) {
 #pragma omp parallel
     loop();
-  } else {
-    loop();
+    return;
   }
+#endif
+  loop();
 }
 
 // body(i) for i in [0, n), split statically over the OpenMP threads if `threaded`.

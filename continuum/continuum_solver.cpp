@@ -8,7 +8,6 @@
 #include <stdexcept>
 
 #include "common/error.hpp"
-#include "common/parallel.hpp"
 #include "continuum/petsc_session.hpp"
 
 namespace arlequin::continuum {

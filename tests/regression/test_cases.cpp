@@ -30,8 +30,18 @@ bool no_temporary_files(const std::filesystem::path& dir) {
   return true;
 }
 
+// The scratch folder of case `name` in the running test: a folder of the test's own, since
+// ctest runs tests side by side and two tests running one case in one folder saw each other's
+// temporary files.
+std::string case_folder(const std::string& name) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string folder = std::string(info->test_suite_name()) + "." + info->name() + "." + name;
+  std::replace(folder.begin(), folder.end(), '/', '_');
+  return folder;
+}
+
 Json run_case(const std::string& name, const std::string& extra = "") {
-  const auto out = test::scratch_dir(name);
+  const auto out = test::scratch_dir(case_folder(name));
   const auto r = test::run_arlequin("run " + cases + name + "/case.yaml --quiet --out " + out.string() + " " + extra);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   for (const char* f : {"series.csv", "summary.json", "case.resolved.yaml"})
@@ -216,7 +226,7 @@ TEST(Cases, PatchCoupledReproducesTheUniformStrain) {
       EXPECT_TRUE(check.at("passed").as_bool()) << extra;
       EXPECT_LE(check.at("value").as_number(), 1e-10) << extra;
     }
-  const std::string csv = test::read_text(std::filesystem::temp_directory_path() / "arlequin_test_patch_coupled" / "series.csv");
+  const std::string csv = test::read_text(test::scratch_path(case_folder("patch_coupled")) / "series.csv");
   const auto second_line = csv.find('\n') + 1;
   const std::string first_row = csv.substr(second_line, csv.find('\n', second_line) - second_line);
   // time, step, deviation, ...
@@ -272,7 +282,7 @@ TEST(Cases, WaveBarCoupledTransmitsThePulse) {
   // pulse, h^2/8 max |v''| = 0.0099 m/s (measured 0.020 m/s, 20 % of the 0.1 m/s amplitude).
   const auto monitor = [] {
     double residual = 0.0, mismatch = 0.0;
-    const auto rows = test::read_csv(std::filesystem::temp_directory_path() / "arlequin_test_wave_bar_coupled" / "series.csv");
+    const auto rows = test::read_csv(test::scratch_path(case_folder("wave_bar_coupled")) / "series.csv");
     EXPECT_GT(rows.size(), 10u);
     for (const auto& row : rows) {
       residual = std::max(residual, test::number(row, "G_residual"));

@@ -37,8 +37,11 @@ inline std::string read_text(const std::filesystem::path& path) {
 }
 
 // A fresh scratch folder under the system temp directory.
+inline std::filesystem::path scratch_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("arlequin_test_" + name);
+}
 inline std::filesystem::path scratch_dir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("arlequin_test_" + name);
+  const auto dir = scratch_path(name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
