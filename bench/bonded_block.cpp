@@ -2,7 +2,9 @@
 // spheres, ~57 600 beam bonds, bottom fixed, top pulled at 0.1 m/s, dt = 1e-7 s), 2000 steps
 // with no output, for 1 and 2 OpenMP threads. Prints setup time, step time, particle-steps/s,
 // bond-steps/s and memory. Usage: bench_bonded_block [steps] [case.yaml]
+#ifdef _OPENMP
 #include <omp.h>
+#endif
 
 #include <chrono>
 #include <cstdio>
@@ -44,7 +46,11 @@ int main(int argc, char** argv) {
   std::printf("layout: %zu B per DE, %zu B per beam bond (targets <= 200, <= 150)\n", per_de, per_bond);
   double one_thread_rate = 0.0;
   for (int threads : {1, 2}) {
+#ifdef _OPENMP
     omp_set_num_threads(threads);
+#else
+    if (threads > 1) break;  // built without OpenMP: one thread only
+#endif
     const double rss_before = memory_bytes().first;
     const auto t0 = Clock::now();
     arlequin::app::Scene scene = arlequin::app::build_scene(case_file, {});
