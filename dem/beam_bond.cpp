@@ -181,26 +181,27 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
 
 void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const {
   assert(count >= 1 && count <= lanes);
-  // Lane l holds bond first + l; lanes past count repeat the last bond (and are dropped).
-  // The DEs' positions are gathered lane by lane, their orientations loaded whole and
-  // transposed; the bonds' own data, stored per component, are consecutive in a block and
-  // load as whole vectors.
+  // Lane l holds bond first + l; lanes past count repeat the last bond (out holds it there
+  // again). The DEs' positions are gathered lane by lane, their orientations loaded whole and
+  // transposed; the bonds' own data, stored per component, are consecutive in a full block
+  // and load as whole vectors.
+  const auto bond_of_lane = [first, count](std::size_t l) { return first + std::min(l, count - 1); };
   LaneVec d;
   Quad qa[lanes], qb[lanes];
   const auto put = [](LaneVec& v, std::size_t l, const Vec3& x) { v.x[l] = x.x, v.y[l] = x.y, v.z[l] = x.z; };
   for (std::size_t l = 0; l < lanes; ++l) {
-    const std::size_t b = first + std::min(l, count - 1);
+    const std::size_t b = bond_of_lane(l);
     const std::uint32_t i = first_[b], j = second_[b];
     put(d, l, p.position[j] - p.position[i]);
     std::memcpy(&qa[l], &p.orientation[i], sizeof(Quad));
     std::memcpy(&qb[l], &p.orientation[j], sizeof(Quad));
   }
   const LaneQuat qi = transpose(qa), qj = transpose(qb);
-  const auto load = [first, count](const std::vector<double>& data) {
+  const auto load = [&](const std::vector<double>& data) {
     Lanes v;
     if (count == lanes) std::memcpy(&v, data.data() + first, sizeof v);
     else
-      for (std::size_t l = 0; l < lanes; ++l) v[l] = data[first + std::min(l, count - 1)];
+      for (std::size_t l = 0; l < lanes; ++l) v[l] = data[bond_of_lane(l)];
     return v;
   };
   const LaneVec direction{load(direction_[0]), load(direction_[1]), load(direction_[2])};
