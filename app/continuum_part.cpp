@@ -106,9 +106,10 @@ class Part final : public ContinuumPart {
     options_.driven_des = dem.driven_particles();
     try {
       coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
-    } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses)
+    } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses, quadrature)
       std::string_view what = e.what();
       if (what.starts_with("coupling: ")) what.remove_prefix(10);
+      if (what.starts_with("quadrature: ")) throw InputError(quadrature_where_ + ": coupling." + std::string(what));
       throw InputError(overlap_where_ + ": coupling.overlap: " + std::string(what));
     }
   }
@@ -190,6 +191,9 @@ class Part final : public ContinuumPart {
     options_.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
     if (options_.coupling.type == coupling::CouplingType::h1)
       options_.coupling.length = section.number("length", Range::positive(), "m");
+    static constexpr std::string_view quadratures[] = {"plain", "consistent"};
+    options_.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
+    quadrature_where_ = section.where("quadrature");
     section.finish();
   }
 
@@ -280,6 +284,7 @@ class Part final : public ContinuumPart {
   std::unique_ptr<ContinuumSolver> solver_;
   std::optional<coupling::OverlapZone> zone_;  // with a coupling section
   std::string overlap_where_;                  // "case.yaml:20", for errors about the overlap
+  std::string quadrature_where_;               // the same for coupling.quadrature
   coupling::CoupledOptions options_;
   std::unique_ptr<coupling::CoupledModel> coupled_;
   std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)

@@ -2,9 +2,12 @@
 
 #include <petscksp.h>
 
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 #include "common/error.hpp"
@@ -57,6 +60,102 @@ void ContinuumSolver::set_weight(ScalarFunction alpha) {
   for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
   mass_ = weighted_lumped_mass(alpha_);
   stiffness_current_ = false;
+}
+
+ContinuumSolver::WeightCorrection ContinuumSolver::correct_weights(const std::vector<Vec3>& target,
+                                                                   const std::vector<char>& constrained) {
+  const int nn = num_nodes(), np = static_cast<int>(points_.x.size());
+  WeightCorrection result;
+  // The points that may change and the constrained nodes they reach (3 rows each).
+  std::vector<int> row(nn, -1), points;
+  for (int q = 0; q < np; ++q)
+    if (alpha_(points_.x[q]) < 1.0) {
+      points.push_back(q);
+      for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+        const int a = points_.node[k];
+        if (constrained.at(a) && row[a] < 0) row[a] = result.nodes++;
+      }
+    }
+  result.points = static_cast<int>(points.size());
+  Eigen::VectorXd w0(result.points);
+  for (int j = 0; j < result.points; ++j) w0[j] = point_weight_[points[j]];
+  Eigen::VectorXd w = w0;
+  if (result.nodes > 0) w = weights_meeting_targets(points, row, result.nodes, target);
+  result.smallest_weight = result.points ? std::numeric_limits<double>::infinity() : 0.0;
+  for (int j = 0; j < result.points; ++j) {
+    const int q = points[j];
+    result.largest_change = std::max(result.largest_change, std::abs(w[j] - w0[j]) / points_.volume[q]);
+    point_weight_[q] = w[j];
+    result.smallest_weight = std::min(result.smallest_weight, w[j] / points_.volume[q]);
+  }
+  stiffness_current_ = false;
+  return result;
+}
+
+Eigen::VectorXd ContinuumSolver::weights_meeting_targets(const std::vector<int>& points, const std::vector<int>& row, int rows,
+                                                         const std::vector<Vec3>& target) const {
+  using Sparse = Eigen::SparseMatrix<double>;
+  const int nn = num_nodes(), np = static_cast<int>(points_.x.size());
+  std::vector<int> column(np, -1);
+  for (std::size_t j = 0; j < points.size(); ++j) column[points[j]] = static_cast<int>(j);
+  // b = target - g (current weights, all points); A(3 row(a) + k, column(q)) = grad_q N_a [k].
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(3 * rows);
+  for (int a = 0; a < nn; ++a)
+    if (row[a] >= 0)
+      for (int k = 0; k < 3; ++k) b[3 * row[a] + k] = target.at(a)[k];
+  std::vector<Eigen::Triplet<double>> t;
+  for (int q = 0; q < np; ++q)
+    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+      const int r = row[points_.node[k]];
+      if (r < 0) continue;
+      const Vec3& g = points_.grad[k];
+      for (int c = 0; c < 3; ++c) {
+        b[3 * r + c] -= point_weight_[q] * g[c];
+        if (column[q] >= 0) t.emplace_back(3 * r + c, column[q], g[c]);
+      }
+    }
+  Sparse A(3 * rows, static_cast<int>(points.size()));
+  A.setFromTriplets(t.begin(), t.end());
+  // The new weights w_q exp((A^T y)_q): positive whatever the correction (so K stays positive
+  // semi-definite), and the closest to the old ones in relative entropy sum_q w'_q ln(w'_q /
+  // w_q) - w'_q + w_q among the weights that meet the targets (y are its Lagrange multipliers;
+  // for small changes it is the least sum_q delta_q^2 / w_q). Newton on A w'(y) = A w + b, with
+  // Jacobian A diag(w') A^T. A diagonal shift of 1e-14 of each row's own diagonal keeps it
+  // factorable when rows are dependent (the partition of unity makes the rows of all nodes of a
+  // region sum to zero) without slowing the rows whose points are few; halving steps keep the
+  // residual falling, and a step that cannot ends the iteration.
+  Eigen::VectorXd w0(points.size());
+  for (std::size_t j = 0; j < points.size(); ++j) w0[j] = point_weight_[points[j]];
+  const Eigen::VectorXd goal = A * w0 + b;
+  // Gauge: a node's sum_q w_q |grad_q N_a|, the size of its weighted terms.
+  const double gauge = (Sparse(A.cwiseAbs()) * w0).maxCoeff();
+  const double tolerance = 1e-13 * gauge;
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(3 * rows), w = w0, residual = b;
+  Eigen::SimplicialLDLT<Sparse> ldlt;
+  bool moved = true;
+  for (int iteration = 0; iteration < 60 && moved && residual.lpNorm<Eigen::Infinity>() > tolerance; ++iteration) {
+    Sparse J = A * w.asDiagonal() * Sparse(A.transpose());
+    const double floor = 1e-12 * J.diagonal().maxCoeff();
+    for (int r = 0; r < J.rows(); ++r) J.coeffRef(r, r) += 1e-14 * std::max(J.coeffRef(r, r), floor);
+    if (iteration == 0) ldlt.analyzePattern(J);
+    ldlt.factorize(J);
+    if (ldlt.info() != Eigen::Success) throw RunError("weight correction: factorisation failed");
+    const Eigen::VectorXd dy = ldlt.solve(residual);
+    moved = false;
+    for (double step = 1.0; step > 1e-6 && !moved; step *= 0.5) {
+      const Eigen::VectorXd y_try = y + step * dy;
+      const Eigen::VectorXd w_try = w0.cwiseProduct((A.transpose() * y_try).array().exp().matrix());
+      const Eigen::VectorXd r_try = goal - A * w_try;
+      if (r_try.norm() < residual.norm()) y = y_try, w = w_try, residual = r_try, moved = true;
+    }
+  }
+  if (!(residual.lpNorm<Eigen::Infinity>() <= 1e-11 * gauge)) {
+    std::ostringstream msg;
+    msg << "the weighted gradients cannot meet their targets (residual " << residual.lpNorm<Eigen::Infinity>()
+        << " m^2 against terms of " << gauge << " m^2)";
+    throw InputError(msg.str());
+  }
+  return w;
 }
 
 std::vector<std::vector<int>> ContinuumSolver::coupled_nodes(int node0, int node1) const {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "dem/laguerre_cells.hpp"
 
 namespace arlequin::coupling {
 
@@ -60,8 +61,9 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
     : dem_(dem), continuum_(continuum), zone_(zone), options_(std::move(options)) {
   continuum_stiffness_floored_ = weight_models(dem_, continuum_, zone_);
   dem_.finalize();
-  continuum_.compute_forces();
   ops_ = CouplingOperators::build(zone_, dem_.particles, continuum_, options_.coupling);
+  if (options_.consistent_quadrature) make_overlap_quadrature_consistent();
+  continuum_.compute_forces();
   const int np = ops_.num_particles(), nn = continuum_.num_nodes();
 
   inv_mass_d_.resize(np);
@@ -96,6 +98,34 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum);
 }
 
+// Under a uniform stress sigma (both models carrying it), DE p's weighted bond forces sum to
+// -sigma h_p, h_p = sum over its Laguerre faces f of alpha_d(centroid_f) A_f (a lattice's bonds
+// cross the faces at their centroids, and its interior DEs have sum_f A_f = 0), and a continuum
+// node's weighted internal force is sigma g_a. The multipliers can cancel both (the static
+// condition r_c = -N^T r_d of either mediator) only if g_a = sum_p N(p, a) h_p at every node
+// whose motion is free: those are the targets.
+void CoupledModel::make_overlap_quadrature_consistent() {
+  const auto faces = dem::laguerre_faces(dem_.particles.reference, dem_.particles.radius, ops_.particles);
+  const int nn = continuum_.num_nodes();
+  std::vector<Vec3> target(nn, Vec3{});
+  for (int p = 0; p < ops_.num_particles(); ++p) {
+    Vec3 h{};
+    for (const auto& f : faces[p]) h += zone_.alpha_d(f.centroid) * f.area;
+    for (SparseMatrix::InnerIterator it(ops_.N, p); it; ++it) target[it.col()] += it.value() * h;
+  }
+  std::vector<char> constrained(nn, 1);
+  for (int d = 0; d < 3 * nn; ++d)
+    if (continuum_.is_fixed(d)) constrained[d / 3] = 0;
+  for (int d : options_.held_continuum_dofs) constrained.at(d / 3) = 0;
+  try {
+    quadrature_correction_ = continuum_.correct_weights(target, constrained);
+  } catch (const InputError& e) {
+    throw InputError(std::string("coupling: quadrature: consistent: ") + e.what() +
+                     " (it needs every free continuum node the overlap reaches to lie inside the coupled body: "
+                     "held boundaries, no free surface through the overlap)");
+  }
+}
+
 std::string CoupledModel::summary() const {
   std::ostringstream s;
   const auto& w = zone_.weighting();
@@ -106,6 +136,10 @@ std::string CoupledModel::summary() const {
     << "coupling operators: mediator " << mediator_name(ops_.settings.mediator) << ", "
     << coupling_type_name(ops_.settings.type);
   if (ops_.settings.type == CouplingType::h1) s << " (length " << ops_.settings.length << " m)";
+  if (options_.consistent_quadrature)
+    s << "; consistent quadrature: " << quadrature_correction_.points << " overlap points weighted for "
+      << quadrature_correction_.nodes << " free nodes (largest change " << quadrature_correction_.largest_change
+      << ", smallest weight " << quadrature_correction_.smallest_weight << " of a point's volume)";
   s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
     << "coupling matrix A: " << solver_->nonzeros() << " non-zeros, " << solver_->factorizations()
     << " Cholesky factor(s), reused every step\n"

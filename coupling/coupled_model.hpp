@@ -14,6 +14,25 @@
 //    of the overlap), the continuum weight becomes max(alpha_c, eps) for mass AND stiffness, as
 //    ContinuumSolver::set_weight has one weight for both; summary() says so. DEs beyond the
 //    overlap on the continuum side must not exist.
+//  - Consistent overlap quadrature (options.consistent_quadrature; "coupling.quadrature:
+//    consistent"). Under a uniform stress sigma carried by both models, the gradient of the
+//    weighted bond energy at DE p is r_d = -sigma h_p, h_p = sum over its Laguerre faces f of
+//    alpha_d(centroid_f) times the face's area vector (exact for a lattice whose bonds cross
+//    the faces at their centroids), and that of the weighted continuum energy at node a is
+//    r_c = sigma g_a, g_a = sum_q w_q grad_q N_a. Static equilibrium with either mediator
+//    needs r_c = -N^T r_d, i.e. g_a = sum_p N(p, a) h_p, at every free node. P1 with constant or linear weights on a mesh matched
+//    to the lattice meets it as it stands; cubic weights, natural neighbours (whose shape
+//    functions reach past the next node plane) and unmatched meshes do not, which is a ghost
+//    force of O(eps E A) at the overlap. With the option, the continuum's overlap point weights
+//    are corrected to meet it (ContinuumSolver::correct_weights: the least change in relative
+//    entropy, so they stay positive and K stays positive semi-definite; the mass is not
+//    touched): the correction is independent of sigma and of time, and leaves K symmetric, so
+//    the energy and the critical step keep their meaning (the step is estimated after it). In
+//    the spirit of variationally consistent integration (Chen, Hillman & Rueter, IJNME 95
+//    (2013)), which corrects a meshfree quadrature to pass the patch test; here the weights,
+//    not the test gradients, are corrected, and the reference is the DE cloud's divergence. It needs the targets to be
+//    reachable: every free node the overlap reaches must lie inside the coupled body (a free
+//    surface through the overlap has each model's own surface flux, which differ; InputError).
 //  - Dofs with essential conditions that lie in the coupling support must be declared
 //    (held_continuum_dofs, driven_des): they get no correction (zero inverse mass in A).
 //  - step(dt), with the constraint acting on accelerations, split over the two half kicks
@@ -53,6 +72,9 @@ namespace arlequin::coupling {
 
 struct CoupledOptions {
   CouplingSettings coupling;
+  // Consistent overlap quadrature (README.md): the continuum's overlap weights are corrected so
+  // that its weighted residual of any uniform stress is the DE cloud's, seen through N.
+  bool consistent_quadrature = false;
   std::vector<int> held_continuum_dofs;     // 3 * node + component
   std::vector<std::uint32_t> driven_des;    // DEs with kinematic boundary conditions
 };
@@ -133,6 +155,7 @@ class CoupledModel {
   void kick_to_trial(double dt);
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
 
+  void make_overlap_quadrature_consistent();
   void gather_dem_velocity(Matrix3& v) const;
   void scatter_dem_velocity(const Matrix3& v);
   std::array<double, 2> acceleration_norm() const;  // DEM, continuum, for energies()
@@ -153,6 +176,7 @@ class CoupledModel {
   Matrix3 vd_, lambda_;
   TimeSteps time_steps_;
   bool continuum_stiffness_floored_ = false;
+  continuum::ContinuumSolver::WeightCorrection quadrature_correction_;
   double coupling_work_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;

@@ -9,10 +9,15 @@
 
 namespace arlequin::dem {
 
-std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vector<double>& r) {
+namespace {
+
+// Calls on_cell(k, cell) with the Laguerre cell of sphere cells[k], each face tagged with the
+// neighbour whose radical plane made it (-1: the box).
+template <class OnCell>
+void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, const std::vector<std::uint32_t>& cells,
+                   OnCell&& on_cell) {
   const std::size_t n = c.size();
-  std::vector<double> volumes(n, 0.0);
-  if (n == 0) return volumes;
+  if (n == 0) return;
   Vec3 lo = c[0], hi = c[0];
   double r_max = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -30,7 +35,8 @@ std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vect
     bins[(static_cast<std::size_t>(cell_of(c[i], 2)) * dims[1] + cell_of(c[i], 1)) * dims[0] + cell_of(c[i], 0)].push_back(i);
 
   std::vector<std::pair<double, std::size_t>> near;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const std::size_t i = cells[k];
     for (int reach = 2;; reach *= 2) {
       // Every sphere within `reach` cells, nearest first (so later planes rarely cut).
       near.clear();
@@ -59,12 +65,45 @@ std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vect
       const double D = reach * cell;
       const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
       if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {
-        volumes[i] = volume(poly);
+        on_cell(k, poly);
         break;
       }
     }
   }
+}
+
+}  // namespace
+
+std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vector<double>& r) {
+  std::vector<std::uint32_t> all(c.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+  std::vector<double> volumes(c.size(), 0.0);
+  for_each_cell(c, r, all, [&](std::size_t k, const Polyhedron& poly) { volumes[k] = volume(poly); });
   return volumes;
+}
+
+std::vector<std::vector<LaguerreFace>> laguerre_faces(const std::vector<Vec3>& c, const std::vector<double>& r,
+                                                      const std::vector<std::uint32_t>& cells) {
+  std::vector<std::vector<LaguerreFace>> faces(cells.size());
+  for_each_cell(c, r, cells, [&](std::size_t k, const Polyhedron& poly) {
+    for (const PolyFace& f : poly) {
+      if (f.tag < 0 || f.pts.size() < 3) continue;
+      // Area and centroid by a fan of triangles from the vertex centre (their signed areas share
+      // the sign of the vertex order).
+      const Vec3 o = vertex_centre(f);
+      double area = 0.0;
+      Vec3 moment{};
+      for (std::size_t v = 0; v < f.pts.size(); ++v) {
+        const Vec3& p = f.pts[v];
+        const Vec3& q = f.pts[(v + 1) % f.pts.size()];
+        const double t = 0.5 * dot(cross(p - o, q - o), f.n);
+        area += t;
+        moment += t * (o + p + q) / 3.0;
+      }
+      if (area != 0.0) faces[k].push_back({static_cast<std::uint32_t>(f.tag), std::abs(area) * f.n, moment / area});
+    }
+  });
+  return faces;
 }
 
 }  // namespace arlequin::dem

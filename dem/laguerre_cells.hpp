@@ -4,8 +4,10 @@
 // the spheres' bounding box. They tile the box (sum of volumes = box volume) and, unlike
 // sphere volume / compaction, a small sphere among large ones gets the room its neighbours
 // leave it: the volume share of a DE's virial stress (RDEF, failure.hpp; Aurenhammer, SIAM J.
-// Comput. 16 (1987) for power diagrams).
+// Comput. 16 (1987) for power diagrams). Their faces between neighbours are the DE cloud's
+// discrete divergence (the Arlequin overlap's consistent quadrature, coupling/README.md).
 #pragma once
+#include <cstdint>
 #include <vector>
 
 #include "common/vec3.hpp"
@@ -14,5 +16,17 @@ namespace arlequin::dem {
 
 // Volume of every sphere's Laguerre cell within the box [min(c - R), max(c + R)] (m^3).
 std::vector<double> laguerre_volumes(const std::vector<Vec3>& centres, const std::vector<double>& radii);
+
+// A face between a cell and a neighbour's: area vector (area times the unit normal pointing out
+// of the cell, m^2) and area centroid (m). Faces on the box are not listed.
+struct LaguerreFace {
+  std::uint32_t neighbour;
+  Vec3 area;
+  Vec3 centroid;
+};
+// The neighbour faces of the cells of spheres `cells` (indices into centres), in that order;
+// all spheres take part in the tessellation.
+std::vector<std::vector<LaguerreFace>> laguerre_faces(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                                      const std::vector<std::uint32_t>& cells);
 
 }  // namespace arlequin::dem

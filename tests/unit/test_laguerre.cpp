@@ -49,3 +49,46 @@ TEST(LaguerreCells, RandomSpheresTileTheirBox) {
   }
   EXPECT_NEAR(sum, (hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z), 1e-10 * sum);
 }
+
+// Faces: in the two-sphere box above the shared face is the square x = 1, |y|, |z| <= 1 (area
+// 4, centroid (1, 0, 0)), pointing out of each cell; the box faces are not listed.
+TEST(LaguerreCells, TwoSpheresShareOneFace) {
+  const auto f = dem::laguerre_faces({{0, 0, 0}, {1.5, 0, 0}}, {1.0, 0.5}, {1, 0});
+  ASSERT_EQ(f.size(), 2u);
+  ASSERT_EQ(f[0].size(), 1u);
+  ASSERT_EQ(f[1].size(), 1u);
+  EXPECT_EQ(f[0][0].neighbour, 0u);  // cell of sphere 1, listed first
+  EXPECT_EQ(f[1][0].neighbour, 1u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(f[0][0].area[k], k == 0 ? -4.0 : 0.0, 1e-12);
+    EXPECT_NEAR(f[1][0].area[k], k == 0 ? 4.0 : 0.0, 1e-12);
+    EXPECT_NEAR(f[0][0].centroid[k], k == 0 ? 1.0 : 0.0, 1e-12);
+  }
+}
+
+// In a simple-cubic lattice an interior cell has its six lattice neighbours' faces, (2R)^2 each
+// at the bond midpoints, and their area vectors close (sum 0: the discrete divergence of a
+// constant); a corner cell has three, and their sum is minus its three box faces.
+TEST(LaguerreCells, CubicLatticeFacesAreTheBondCrossSections) {
+  const double R = 0.3, a = 2 * R;
+  std::vector<Vec3> c;
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) c.push_back({a * i, a * j, a * k});
+  const std::uint32_t interior = 1 + 4 * (1 + 4 * 1), corner = 0;
+  const auto faces = dem::laguerre_faces(c, std::vector<double>(c.size(), R), {interior, corner});
+  ASSERT_EQ(faces[0].size(), 6u);
+  Vec3 sum{};
+  for (const auto& f : faces[0]) {
+    EXPECT_NEAR(norm(f.area), a * a, 1e-12);
+    const Vec3 mid = 0.5 * (c[interior] + c[f.neighbour]);
+    EXPECT_NEAR(norm(f.centroid - mid), 0.0, 1e-12);
+    EXPECT_NEAR(dot(f.area, c[f.neighbour] - c[interior]), a * a * a, 1e-12);  // outward
+    sum += f.area;
+  }
+  EXPECT_NEAR(norm(sum), 0.0, 1e-12);
+  ASSERT_EQ(faces[1].size(), 3u);
+  Vec3 corner_sum{};
+  for (const auto& f : faces[1]) corner_sum += f.area;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(corner_sum[k], a * a, 1e-12);
+}
