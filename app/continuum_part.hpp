@@ -30,8 +30,9 @@
 //     weight: linear | cubic | constant   (constant_value: 0.5), mass_floor: 0.05
 //     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
 //     quadrature: plain | consistent   (consistent: the continuum's overlap weights are
-//       corrected so that a uniform stress leaves no ghost force, coupling/coupled_model.hpp;
-//       for overlaps whose continuum nodes are held or inside the coupled body)
+//       corrected so that a uniform stress leaves a lattice no ghost force,
+//       coupling/coupled_model.hpp; for overlaps whose free continuum nodes lie inside the
+//       coupled body)
 // The overlap also cuts both models to their domains: tetrahedra with every vertex in the
 // pure-DEM zone are left out of the mesh here, and the scene does not create the sample's DEs
 // beyond the overlap (in_dem_domain), so a mesh and a sample may each cover the whole body.

@@ -80,7 +80,7 @@ ContinuumSolver::WeightCorrection ContinuumSolver::correct_weights(const std::ve
   Eigen::VectorXd w0(result.points);
   for (int j = 0; j < result.points; ++j) w0[j] = point_weight_[points[j]];
   Eigen::VectorXd w = w0;
-  if (result.nodes > 0) w = weights_meeting_targets(points, row, result.nodes, target);
+  if (result.nodes > 0) w = weights_meeting_targets(points, w0, row, result.nodes, target);
   result.smallest_weight = result.points ? std::numeric_limits<double>::infinity() : 0.0;
   for (int j = 0; j < result.points; ++j) {
     const int q = points[j];
@@ -92,7 +92,8 @@ ContinuumSolver::WeightCorrection ContinuumSolver::correct_weights(const std::ve
   return result;
 }
 
-Eigen::VectorXd ContinuumSolver::weights_meeting_targets(const std::vector<int>& points, const std::vector<int>& row, int rows,
+Eigen::VectorXd ContinuumSolver::weights_meeting_targets(const std::vector<int>& points, const Eigen::VectorXd& w0,
+                                                         const std::vector<int>& row, int rows,
                                                          const std::vector<Vec3>& target) const {
   using Sparse = Eigen::SparseMatrix<double>;
   const int nn = num_nodes(), np = static_cast<int>(points_.x.size());
@@ -119,13 +120,11 @@ Eigen::VectorXd ContinuumSolver::weights_meeting_targets(const std::vector<int>&
   // The new weights w_q exp((A^T y)_q): positive whatever the correction (so K stays positive
   // semi-definite), and the closest to the old ones in relative entropy sum_q w'_q ln(w'_q /
   // w_q) - w'_q + w_q among the weights that meet the targets (y are its Lagrange multipliers;
-  // for small changes it is the least sum_q delta_q^2 / w_q). Newton on A w'(y) = A w + b, with
+  // for small changes it is the least sum_q delta_q^2 / w_q). Newton on A w'(y) = A w0 + b, with
   // Jacobian A diag(w') A^T. A diagonal shift of 1e-14 of each row's own diagonal keeps it
   // factorable when rows are dependent (the partition of unity makes the rows of all nodes of a
   // region sum to zero) without slowing the rows whose points are few; halving steps keep the
   // residual falling, and a step that cannot ends the iteration.
-  Eigen::VectorXd w0(points.size());
-  for (std::size_t j = 0; j < points.size(); ++j) w0[j] = point_weight_[points[j]];
   const Eigen::VectorXd goal = A * w0 + b;
   // Gauge: a node's sum_q w_q |grad_q N_a|, the size of its weighted terms.
   const double gauge = (Sparse(A.cwiseAbs()) * w0).maxCoeff();
@@ -135,8 +134,8 @@ Eigen::VectorXd ContinuumSolver::weights_meeting_targets(const std::vector<int>&
   bool moved = true;
   for (int iteration = 0; iteration < 60 && moved && residual.lpNorm<Eigen::Infinity>() > tolerance; ++iteration) {
     Sparse J = A * w.asDiagonal() * Sparse(A.transpose());
-    const double floor = 1e-12 * J.diagonal().maxCoeff();
-    for (int r = 0; r < J.rows(); ++r) J.coeffRef(r, r) += 1e-14 * std::max(J.coeffRef(r, r), floor);
+    const double least_diagonal = 1e-12 * J.diagonal().maxCoeff();
+    for (int r = 0; r < J.rows(); ++r) J.coeffRef(r, r) += 1e-14 * std::max(J.coeffRef(r, r), least_diagonal);
     if (iteration == 0) ldlt.analyzePattern(J);
     ldlt.factorize(J);
     if (ldlt.info() != Eigen::Success) throw RunError("weight correction: factorisation failed");

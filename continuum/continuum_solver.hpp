@@ -71,18 +71,21 @@ class ContinuumSolver {
   void set_weight(ScalarFunction alpha);
   const std::vector<double>& lumped_mass() const { return mass_; }  // per node, weighted
 
-  // Consistency of a weighted quadrature (coupling/README.md, "Consistent overlap quadrature").
-  // Under a uniform stress sigma the weighted internal force of node a is sigma g_a, with
+  // Consistency of a weighted quadrature (the Arlequin overlap's consistent quadrature,
+  // coupling/coupled_model.hpp). Under a uniform stress sigma the weighted internal force of
+  // node a is sigma g_a, with
   //   g_a = sum_q w_q grad_q N_a   (m^2).
-  // This changes the weights w_q of the points where alpha(x_q) < 1 (the overlap) by the
-  // least sum_q delta_q^2 / |cell_q| such that g_a = target[a] at every node with
-  // constrained[a] that those points reach (the others cannot change), and leaves the lumped
-  // mass as it is. Targets that cannot be met (e.g. contradicting a free surface's own flux)
-  // are an InputError. Call after set_weight.
+  // This changes the weights w_q of the points where alpha(x_q) < 1 (the overlap) to
+  // w_q exp((A^T y)_q), the closest to the old ones in relative entropy (for small changes:
+  // the least sum_q delta_q^2 / w_q), such that g_a = target[a] at every node with
+  // constrained[a] that those points reach (the others cannot change, and their targets are
+  // not looked at). The weights stay positive; the lumped mass is not changed. Targets that
+  // cannot be met (e.g. contradicting a free surface's own flux) are an InputError, and then
+  // nothing has changed. Call after set_weight.
   struct WeightCorrection {
-    int points = 0;               // points whose weight changed
-    int nodes = 0;                // constrained nodes
-    double largest_change = 0.0;  // max |delta_q| / |cell_q|
+    int points = 0;                // points allowed to change (alpha < 1)
+    int nodes = 0;                 // constrained nodes they reach
+    double largest_change = 0.0;   // max |delta_q| / |cell_q|
     double smallest_weight = 0.0;  // min w_q / |cell_q| over those points after the change
   };
   WeightCorrection correct_weights(const std::vector<Vec3>& target, const std::vector<char>& constrained);
@@ -183,10 +186,10 @@ class ContinuumSolver {
   void point_stiffness(int q, std::vector<int>& nodes, std::vector<double>& Ke) const;
   // K = sum_q w_q B_q^T C_q B_q, assembled on first use after the weight was set.
   const BlockMatrix3& stiffness() const;
-  // correct_weights' solve: the new weights of `points` (row[a]: the row block of constrained
-  // node a, or -1; `rows` blocks).
-  Eigen::VectorXd weights_meeting_targets(const std::vector<int>& points, const std::vector<int>& row, int rows,
-                                          const std::vector<Vec3>& target) const;
+  // correct_weights' solve: the new weights of `points`, whose weights now are w0 (row[a]: the
+  // row block of constrained node a, or -1; `rows` blocks).
+  Eigen::VectorXd weights_meeting_targets(const std::vector<int>& points, const Eigen::VectorXd& w0,
+                                          const std::vector<int>& row, int rows, const std::vector<Vec3>& target) const;
 
   ScalarFunction alpha_;
   std::vector<double> point_weight_;  // alpha(x_q) volume_q

@@ -98,28 +98,25 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum);
 }
 
-// Under a uniform stress sigma (both models carrying it), DE p's weighted bond forces sum to
-// -sigma h_p, h_p = sum over its Laguerre faces f of alpha_d(centroid_f) A_f (a lattice's bonds
-// cross the faces at their centroids, and its interior DEs have sum_f A_f = 0), and a continuum
-// node's weighted internal force is sigma g_a. The multipliers can cancel both (the static
-// condition r_c = -N^T r_d of either mediator) only if g_a = sum_p N(p, a) h_p at every node
-// whose motion is free: those are the targets.
+// The targets of the contract's consistent quadrature: g_a = sum_p N(p, a) h_p, h_p = sum over
+// the Laguerre faces f of DE p of alpha_d(centroid_f) A_f (the weighted bond energy's gradient
+// at p is -sigma h_p). Nodes with every dof held or fixed take reactions and get none.
 void CoupledModel::make_overlap_quadrature_consistent() {
-  const auto faces = dem::laguerre_faces(dem_.particles.reference, dem_.particles.radius, ops_.particles);
   const int nn = continuum_.num_nodes();
   std::vector<Vec3> target(nn, Vec3{});
-  for (int p = 0; p < ops_.num_particles(); ++p) {
-    Vec3 h{};
-    for (const auto& f : faces[p]) h += zone_.alpha_d(f.centroid) * f.area;
-    for (SparseMatrix::InnerIterator it(ops_.N, p); it; ++it) target[it.col()] += it.value() * h;
-  }
-  std::vector<char> constrained(nn, 1);
-  for (int d = 0; d < 3 * nn; ++d)
-    if (continuum_.is_fixed(d)) constrained[d / 3] = 0;
-  for (int d : options_.held_continuum_dofs) constrained.at(d / 3) = 0;
+  std::vector<char> held(3 * static_cast<size_t>(nn), 0), constrained(nn, 0);
+  for (int d = 0; d < 3 * nn; ++d) held[d] = continuum_.is_fixed(d);
+  for (int d : options_.held_continuum_dofs) held.at(d) = 1;
+  for (int a = 0; a < nn; ++a) constrained[a] = !(held[3 * a] && held[3 * a + 1] && held[3 * a + 2]);
   try {
+    const auto faces = dem::laguerre_faces(dem_.particles.reference, dem_.particles.radius, ops_.particles);
+    for (int p = 0; p < ops_.num_particles(); ++p) {
+      Vec3 h{};
+      for (const auto& f : faces[p]) h += zone_.alpha_d(f.centroid) * f.area;
+      for (SparseMatrix::InnerIterator it(ops_.N, p); it; ++it) target[it.col()] += it.value() * h;
+    }
     quadrature_correction_ = continuum_.correct_weights(target, constrained);
-  } catch (const InputError& e) {
+  } catch (const std::runtime_error& e) {  // InputError, or RunError from the solve
     throw InputError(std::string("coupling: quadrature: consistent: ") + e.what() +
                      " (it needs every free continuum node the overlap reaches to lie inside the coupled body: "
                      "held boundaries, no free surface through the overlap)");

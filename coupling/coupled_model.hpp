@@ -17,22 +17,26 @@
 //  - Consistent overlap quadrature (options.consistent_quadrature; "coupling.quadrature:
 //    consistent"). Under a uniform stress sigma carried by both models, the gradient of the
 //    weighted bond energy at DE p is r_d = -sigma h_p, h_p = sum over its Laguerre faces f of
-//    alpha_d(centroid_f) times the face's area vector (exact for a lattice whose bonds cross
-//    the faces at their centroids), and that of the weighted continuum energy at node a is
-//    r_c = sigma g_a, g_a = sum_q w_q grad_q N_a. Static equilibrium with either mediator
-//    needs r_c = -N^T r_d, i.e. g_a = sum_p N(p, a) h_p, at every free node. P1 with constant or linear weights on a mesh matched
-//    to the lattice meets it as it stands; cubic weights, natural neighbours (whose shape
-//    functions reach past the next node plane) and unmatched meshes do not, which is a ghost
-//    force of O(eps E A) at the overlap. With the option, the continuum's overlap point weights
-//    are corrected to meet it (ContinuumSolver::correct_weights: the least change in relative
-//    entropy, so they stay positive and K stays positive semi-definite; the mass is not
-//    touched): the correction is independent of sigma and of time, and leaves K symmetric, so
-//    the energy and the critical step keep their meaning (the step is estimated after it). In
-//    the spirit of variationally consistent integration (Chen, Hillman & Rueter, IJNME 95
-//    (2013)), which corrects a meshfree quadrature to pass the patch test; here the weights,
-//    not the test gradients, are corrected, and the reference is the DE cloud's divergence. It needs the targets to be
-//    reachable: every free node the overlap reaches must lie inside the coupled body (a free
-//    surface through the overlap has each model's own surface flux, which differ; InputError).
+//    alpha_d(centroid_f) times the face's area vector A_f; this holds for a lattice whose bonds
+//    cross the faces at their centroids and carry sigma A_f (the simple-cubic lattice under
+//    normal stresses, the patch test's case; a random packing has no uniform static state to
+//    begin with). That of the weighted continuum energy at node a is r_c = sigma g_a, g_a =
+//    sum_q w_q grad_q N_a. Static equilibrium with either mediator needs r_c = -N^T r_d, i.e.
+//    g_a = sum_p N(p, a) h_p at every node with a free dof (a sufficient condition where the
+//    overlap holds driven DEs: their h_p is counted as for free ones). P1 with constant or
+//    linear weights meets it on a mesh matched to the lattice (and with the fine mediator on
+//    coarser ones); cubic weights and natural neighbours (whose shape functions reach past the
+//    next node plane) do not, which is a ghost force of O(eps E A) at the overlap. With the
+//    option, the continuum's overlap point weights are corrected to meet it
+//    (ContinuumSolver::correct_weights: the least change in relative entropy, so they stay
+//    positive and K positive semi-definite; the mass is not touched). The correction depends
+//    neither on sigma nor on time and keeps K symmetric, so the energy and the critical step
+//    keep their meaning (the step is estimated after it). In the spirit of variationally
+//    consistent integration (Chen, Hillman & Rueter, IJNME 95 (2013)), which corrects a
+//    meshfree quadrature to pass the patch test; here the weights, not the test gradients, are
+//    corrected, and the reference is the DE cloud's divergence. The targets must be reachable:
+//    every free node the overlap reaches must lie inside the coupled body (a free surface
+//    through the overlap has each model's own surface flux, and they differ; InputError).
 //  - Dofs with essential conditions that lie in the coupling support must be declared
 //    (held_continuum_dofs, driven_des): they get no correction (zero inverse mass in A).
 //  - step(dt), with the constraint acting on accelerations, split over the two half kicks
@@ -72,8 +76,9 @@ namespace arlequin::coupling {
 
 struct CoupledOptions {
   CouplingSettings coupling;
-  // Consistent overlap quadrature (README.md): the continuum's overlap weights are corrected so
-  // that its weighted residual of any uniform stress is the DE cloud's, seen through N.
+  // Consistent overlap quadrature (above; cases/patch_coupled/README.md): the continuum's
+  // overlap weights are corrected so that its weighted residual of a uniform stress is the DE
+  // cloud's, seen through N.
   bool consistent_quadrature = false;
   std::vector<int> held_continuum_dofs;     // 3 * node + component
   std::vector<std::uint32_t> driven_des;    // DEs with kinematic boundary conditions

@@ -87,7 +87,7 @@ std::vector<std::vector<LaguerreFace>> laguerre_faces(const std::vector<Vec3>& c
   std::vector<std::vector<LaguerreFace>> faces(cells.size());
   for_each_cell(c, r, cells, [&](std::size_t k, const Polyhedron& poly) {
     for (const PolyFace& f : poly) {
-      if (f.tag < 0 || f.pts.size() < 3) continue;
+      if (f.tag < 0) continue;
       // Area and centroid by a fan of triangles from the vertex centre (their signed areas share
       // the sign of the vertex order).
       const Vec3 o = vertex_centre(f);

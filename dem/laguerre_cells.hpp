@@ -5,7 +5,7 @@
 // sphere volume / compaction, a small sphere among large ones gets the room its neighbours
 // leave it: the volume share of a DE's virial stress (RDEF, failure.hpp; Aurenhammer, SIAM J.
 // Comput. 16 (1987) for power diagrams). Their faces between neighbours are the DE cloud's
-// discrete divergence (the Arlequin overlap's consistent quadrature, coupling/README.md).
+// discrete divergence (the Arlequin overlap's consistent quadrature, coupling/coupled_model.hpp).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 // ContinuumSolver::correct_weights (the Arlequin overlap's consistent quadrature,
-// coupling/README.md): the weighted gradient sums g_a = sum_q w_q grad_q N_a meet their targets,
+// coupling/coupled_model.hpp): the weighted gradient sums g_a = sum_q w_q grad_q N_a meet their targets,
 // the weights stay positive, and nothing outside alpha < 1 moves.
 #include <gtest/gtest.h>
 
@@ -74,6 +74,8 @@ TEST(ContinuumWeightCorrection, MeetsReachableTargetsWithPositiveWeights) {
     // weights' sum of gradients, zero) are refused.
     std::vector<Vec3> wrong = g0;
     wrong[0] += Vec3{1e-3 * gauge, 0, 0};
+    const std::vector<double> corrected = s->point_weights();
     EXPECT_THROW(s->correct_weights(wrong, all), InputError) << method;
+    EXPECT_EQ(s->point_weights(), corrected) << method;  // a refused correction changes nothing
   }
 }

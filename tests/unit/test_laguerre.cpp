@@ -7,6 +7,20 @@
 
 using namespace arlequin;
 
+namespace {
+
+// `count` spheres, centres uniform in the unit cube, radii uniform in [0.02, 0.08].
+void random_spheres(unsigned seed, int count, std::vector<Vec3>& c, std::vector<double>& r) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> pos(0.0, 1.0), rad(0.02, 0.08);
+  for (int i = 0; i < count; ++i) {
+    c.push_back({pos(rng), pos(rng), pos(rng)});
+    r.push_back(rad(rng));
+  }
+}
+
+}  // namespace
+
 // Two touching spheres, R 1 and 0.5, centres 1.5 apart: the radical plane 2 (1.5) x = 1.5^2 -
 // 0.25 + 1 is x = 1; in the box [-1, 2] x [-1, 1]^2 the cells are 2 x 2 x 2 and 1 x 2 x 2.
 TEST(LaguerreCells, TwoSpheresSplitAtTheRadicalPlane) {
@@ -30,14 +44,9 @@ TEST(LaguerreCells, CubicLatticeGivesTheLatticeCube) {
 // Random radii and positions: the cells tile the box, and a small sphere among large ones gets
 // more than its share by R^3 (the point of using them).
 TEST(LaguerreCells, RandomSpheresTileTheirBox) {
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> pos(0.0, 1.0), rad(0.02, 0.08);
   std::vector<Vec3> c;
   std::vector<double> r;
-  for (int i = 0; i < 400; ++i) {
-    c.push_back({pos(rng), pos(rng), pos(rng)});
-    r.push_back(rad(rng));
-  }
+  random_spheres(3, 400, c, r);
   const auto v = dem::laguerre_volumes(c, r);
   Vec3 lo = c[0], hi = c[0];
   for (std::size_t i = 0; i < c.size(); ++i)
@@ -91,4 +100,33 @@ TEST(LaguerreCells, CubicLatticeFacesAreTheBondCrossSections) {
   Vec3 corner_sum{};
   for (const auto& f : faces[1]) corner_sum += f.area;
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(corner_sum[k], a * a, 1e-12);
+}
+
+// Random spheres: for a cell clear of the box, its faces are all neighbour faces, so the
+// divergence theorem gives sum_f A_f = 0 and sum_f c_f (x) A_f = V I (int_dV x_k n_j dS =
+// V delta_kj; exact with the faces' area centroids c_f, as x is linear on a face; the mean of a
+// face's vertices would not do for these irregular polygons).
+TEST(LaguerreCells, FacesCloseEveryInteriorCell) {
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  random_spheres(5, 300, c, r);
+  std::vector<std::uint32_t> all(c.size());
+  for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  const auto volumes = dem::laguerre_volumes(c, r);
+  const auto faces = dem::laguerre_faces(c, r, all);
+  int interior = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    Vec3 sum{};
+    double moment[3][3] = {}, area = 0.0;
+    for (const auto& f : faces[i]) {
+      sum += f.area, area += norm(f.area);
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j) moment[k][j] += f.centroid[k] * f.area[j];
+    }
+    if (norm(sum) > 1e-9 * area) continue;  // a box face closes this cell
+    ++interior;
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(moment[k][j], k == j ? volumes[i] : 0.0, 1e-10 * volumes[i]) << "cell " << i;
+  }
+  EXPECT_GT(interior, 50);
 }
