@@ -194,6 +194,13 @@ class Part final : public ContinuumPart {
     static constexpr std::string_view quadratures[] = {"plain", "consistent"};
     options_.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
     quadrature_where_ = section.where("quadrature");
+    static constexpr std::string_view solvers[] = {"petsc", "direct"};
+    if (section.choice_or("solver", "petsc", solvers) == "petsc")
+      options_.multiplier_petsc_options = section.string_or("petsc_options", "");
+    else if (section.has("petsc_options"))
+      section.fail("petsc_options", "is read by coupling.solver: petsc only (the direct solver has no options)");
+    else
+      options_.multiplier_petsc_options.reset();
     section.finish();
   }
 

@@ -76,7 +76,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   inv_mass_c_.resize(3 * static_cast<size_t>(nn));
   for (int d = 0; d < 3 * nn; ++d) inv_mass_c_[d] = 1.0 / continuum_.lumped_mass()[d / 3];
   for (int d : options_.held_continuum_dofs) inv_mass_c_.at(d) = 0.0;
-  solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_);
+  solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_, options_.multiplier_petsc_options);
 
   // Initial velocities onto the constraint.
   gather_dem_velocity(vd_);
@@ -138,8 +138,8 @@ std::string CoupledModel::summary() const {
       << quadrature_correction_.nodes << " free nodes (largest change " << quadrature_correction_.largest_change
       << ", smallest weight " << quadrature_correction_.smallest_weight << " of a point's volume)";
   s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
-    << "coupling matrix A: " << solver_->nonzeros() << " non-zeros, " << solver_->factorizations()
-    << " Cholesky factor(s), reused every step\n"
+    << "coupling matrix A: " << solver_->nonzeros() << " non-zeros, " << solver_->factorizations() << " factor(s) ("
+    << solver_->backend() << "), reused every step\n"
     << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum
     << " s, coupled " << time_steps_.coupled << " s\n";
   return s.str();

@@ -63,6 +63,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -80,6 +81,10 @@ struct CoupledOptions {
   // overlap weights are corrected so that its weighted residual of a uniform stress is the DE
   // cloud's, seen through N.
   bool consistent_quadrature = false;
+  // The multiplier solve: PETSc's KSP with these options (default: none, i.e. preonly +
+  // cholesky), or nullopt for our own sparse LDL^T (MultiplierSolver; case keys
+  // "coupling.solver: petsc | direct", "coupling.petsc_options").
+  std::optional<std::string> multiplier_petsc_options = std::string();
   std::vector<int> held_continuum_dofs;     // 3 * node + component
   std::vector<std::uint32_t> driven_des;    // DEs with kinematic boundary conditions
 };

@@ -9,7 +9,7 @@
 namespace arlequin::coupling {
 
 MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
-                                   const std::vector<double>& inv_mass_c)
+                                   const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc)
     : ops_(&ops) {
   const int np = ops.num_particles(), nn = static_cast<int>(ops.Gc.cols());
   if (static_cast<int>(inv_mass_d.size()) != np || static_cast<int>(inv_mass_c.size()) != 3 * nn)
@@ -43,6 +43,13 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     for (Eigen::Index r = 0; r < scale.size(); ++r)
       if (scale[r] == 0.0) Acol.coeffRef(r, r) = 1.0;
     nonzeros_ = Acol.nonZeros();
+    if (petsc) {
+      if (!ok) throw RunError("coupling: the multiplier matrix A has a negative or zero diagonal");
+      factor_of_[c] = static_cast<int>(scales_.size());
+      petsc_.push_back(std::make_unique<PetscSpdSolver>(Acol, *petsc));
+      scales_.push_back(scale);
+      continue;
+    }
     auto f = std::make_unique<Factor>();
     if (ok) f->compute(Acol);
     ok = ok && f->info() == Eigen::Success;
@@ -73,8 +80,14 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
   lambda.resize(rhs.rows(), 3);
   for (int c = 0; c < 3; ++c) {
     const int k = factor_of_[c];
-    const Factor& f = *factors_[k];
     column_ = rhs.col(c).cwiseProduct(scales_[k]);
+    if (!petsc_.empty()) {
+      solution_.resize(column_.size());
+      petsc_[k]->solve(column_.data(), solution_.data());
+      lambda.col(c) = solution_.cwiseProduct(scales_[k]);
+      continue;
+    }
+    const Factor& f = *factors_[k];
     solution_ = f.permutationP() * column_;
     f.matrixL().solveInPlace(solution_);
     solution_.array() /= diagonals_[k].array();
@@ -83,6 +96,8 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
     lambda.col(c) = column_.cwiseProduct(scales_[k]);
   }
 }
+
+std::string MultiplierSolver::backend() const { return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description(); }
 
 void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const {
   out.noalias() = ops_->Gd * vd;

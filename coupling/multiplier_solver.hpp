@@ -19,14 +19,22 @@
 //    coupled model, not shared between threads).
 //  - RunError if A is not positive definite (e.g. a coarse mediator with too few DEs per
 //    element to fix every mediator node; the message suggests the fine mediator).
+//  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
+//    the same Jacobi-scaled A, with the case's options: PETSc's way of choosing a solver at run
+//    time, e.g. an iterative one for a large overlap; the application's default, preonly +
+//    cholesky). Ours is about 1 us per step cheaper on the wave bar (cases/wave_bar_coupled/
+//    README.md).
 #pragma once
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <array>
 #include <memory>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "coupling/coupling_operators.hpp"
+#include "coupling/petsc_spd_solver.hpp"
 
 namespace arlequin::coupling {
 
@@ -35,8 +43,9 @@ using Matrix3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;  // o
 class MultiplierSolver {
  public:
   // inv_mass_d: per coupled DE; inv_mass_c: per continuum dof (3 per node, node-major).
+  // petsc: nullopt for our LDL^T, else PETSc with these options (empty: its defaults).
   MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
-                   const std::vector<double>& inv_mass_c);
+                   const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc = std::nullopt);
 
   // A lambda = rhs per component (rhs, lambda: rows x 3).
   void solve(const Matrix3& rhs, Matrix3& lambda) const;
@@ -45,7 +54,9 @@ class MultiplierSolver {
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
-  int factorizations() const { return static_cast<int>(factors_.size()); }
+  int factorizations() const { return static_cast<int>(scales_.size()); }
+  // "LDL^T" or "PETSc <ksp> + <pc>".
+  std::string backend() const;
   int rows() const { return ops_->rows(); }
   long nonzeros() const { return nonzeros_; }
 
@@ -53,7 +64,8 @@ class MultiplierSolver {
   using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
   const CouplingOperators* ops_;
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
-  std::vector<std::unique_ptr<Factor>> factors_;
+  std::vector<std::unique_ptr<Factor>> factors_;  // our LDL^T, or
+  std::vector<std::unique_ptr<PetscSpdSolver>> petsc_;  // PETSc's solve
   std::vector<Eigen::VectorXd> diagonals_;     // D of each factor
   std::vector<Eigen::VectorXd> scales_;        // Jacobi scaling diag(A)^-1/2 of each factor
   std::array<int, 3> factor_of_{0, 0, 0};      // component -> factor

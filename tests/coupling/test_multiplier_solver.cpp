@@ -1,5 +1,6 @@
 // MultiplierSolver on hand-built operators: the projection onto ker G against its closed form,
-// and a row whose dofs are all held (empty row, multiplier 0) beside rows that are not.
+// and a row whose dofs are all held (empty row, multiplier 0) beside rows that are not; with
+// each backend (our LDL^T, PETSc's direct and an iterative PETSc solve).
 #include <gtest/gtest.h>
 
 #include "common/error.hpp"
@@ -29,9 +30,13 @@ CouplingOperators one_to_one(const std::vector<double>& w) {
   return ops;
 }
 
+// nullopt: our LDL^T; a string: PETSc with these options.
+const std::optional<std::string> backends[] = {std::nullopt, std::string(), std::string("-ksp_type cg -pc_type jacobi -ksp_rtol 1e-14")};
+
 }  // namespace
 
 TEST(CouplingMultiplierSolver, ProjectionIsTheMomentumWeightedMeanAndAHeldRowIsEmpty) {
+  for (const auto& backend : backends) {
   const std::vector<double> w{0.5, 1.0, 2.0, 0.25};
   const CouplingOperators ops = one_to_one(w);
   // Row 0: DE and node held (inverse masses 0): empty. Row 2: DE held, node free. Rows 1, 3 free.
@@ -40,8 +45,8 @@ TEST(CouplingMultiplierSolver, ProjectionIsTheMomentumWeightedMeanAndAHeldRowIsE
   const double node_inv[4] = {0.0, 1.0, 3.0, 0.5};
   for (int i = 0; i < 4; ++i)
     for (int c = 0; c < 3; ++c) mc.push_back(node_inv[i] * (c == 1 && i != 0 ? 2.0 : 1.0));
-  const MultiplierSolver solver(ops, md, mc);
-  EXPECT_EQ(solver.factorizations(), 2);  // y differs from x, z reuses x's factor
+  const MultiplierSolver solver(ops, md, mc, backend);
+  EXPECT_EQ(solver.factorizations(), 2) << solver.backend();  // y differs from x, z reuses x's factor
 
   Matrix3 vd(4, 3), vc(4, 3), dd, dc, lambda;
   vd << 1, 2, 3, -1, 0.5, 2, 4, -3, 1, 0.2, 0.3, -0.7;
@@ -65,6 +70,7 @@ TEST(CouplingMultiplierSolver, ProjectionIsTheMomentumWeightedMeanAndAHeldRowIsE
       EXPECT_NEAR(dd(i, c), vd0(i, c) - vd(i, c), 1e-12);
       EXPECT_NEAR(dc(i, c), vc0(i, c) - vc(i, c), 1e-12);
     }
+  }
 }
 
 TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
@@ -76,5 +82,13 @@ TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
   ops.Gc.resize(2, 1);
   ops.Gd.insert(0, 0) = 1.0;
   ops.Gd.insert(1, 0) = 2.0;
-  EXPECT_THROW(MultiplierSolver(ops, {1.0}, {1.0, 1.0, 1.0}), RunError);
+  for (const auto& backend : backends)
+    EXPECT_THROW(
+        {
+          const MultiplierSolver solver(ops, {1.0}, {1.0, 1.0, 1.0}, backend);
+          Matrix3 lambda;
+          solver.solve(Matrix3::Ones(2, 3), lambda);  // an iterative backend finds out here
+        },
+        RunError)
+        << (backend ? "PETSc " + *backend : "LDL^T");
 }

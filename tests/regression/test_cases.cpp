@@ -301,6 +301,29 @@ TEST(Cases, LatticeBarFailsAtTheBondStrength) {
   EXPECT_NEAR(energy_balance(s), 0.0, 1e-2 * s.at("energies").at("external_work").as_number());
 }
 
+// The multiplier solve is a runtime choice: PETSc's (default: preonly + cholesky; here also
+// an iterative one from the case's options) and our own LDL^T give R to 1e-9; options for the
+// direct solver are refused, and a PETSc solve that does not converge stops the run.
+TEST(Cases, WaveBarCoupledMultiplierSolverIsARuntimeChoice) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto R = [](const Json& s) { return s.at("checks").as_array().at(0).at("value").as_number(); };
+  const double petsc = R(run_case("wave_bar_coupled", "--set output.fields=[]"));
+  EXPECT_NEAR(R(run_case("wave_bar_coupled", "--set output.fields=[] --set coupling.solver=direct")), petsc, 1e-9 * petsc);
+  EXPECT_NEAR(R(run_case("wave_bar_coupled", "--set output.fields=[] --set 'coupling.petsc_options=\"-ksp_type cg -pc_type jacobi -ksp_rtol 1e-14\"'")),
+              petsc, 1e-9 * petsc);
+  const auto out = test::scratch_dir(case_folder("refused"));
+  const auto direct = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() +
+                                         " --set coupling.solver=direct --set coupling.petsc_options=-ksp_type");
+  EXPECT_EQ(direct.exit_code, 2);
+  EXPECT_NE(direct.output.find("coupling.petsc_options: is read by coupling.solver: petsc only"), std::string::npos) << direct.output;
+  const auto stalled = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() +
+                                          " --set 'coupling.petsc_options=\"-ksp_type cg -pc_type none -ksp_max_it 2\"'");
+  EXPECT_EQ(stalled.exit_code, 3);
+  EXPECT_NE(stalled.output.find("the multiplier solve did not converge (DIVERGED_ITS"), std::string::npos) << stalled.output;
+}
+
 // R6 on a 3D bar: the pulse leaves the DEM through the overlap; the energy left behind is R.
 TEST(Cases, WaveBarCoupledTransmitsThePulse) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
