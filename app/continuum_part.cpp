@@ -110,6 +110,7 @@ class Part final : public ContinuumPart {
       std::string_view what = e.what();
       if (what.starts_with("coupling: ")) what.remove_prefix(10);
       if (what.starts_with("quadrature: ")) throw InputError(quadrature_where_ + ": coupling." + std::string(what));
+      if (what.starts_with("petsc_options: ")) throw InputError(petsc_where_ + ": coupling." + std::string(what));
       throw InputError(overlap_where_ + ": coupling.overlap: " + std::string(what));
     }
   }
@@ -195,6 +196,7 @@ class Part final : public ContinuumPart {
     options_.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
     quadrature_where_ = section.where("quadrature");
     static constexpr std::string_view solvers[] = {"petsc", "direct"};
+    petsc_where_ = section.where("petsc_options");
     if (section.choice_or("solver", "petsc", solvers) == "petsc")
       options_.multiplier_petsc_options = section.string_or("petsc_options", "");
     else if (section.has("petsc_options"))
@@ -292,6 +294,7 @@ class Part final : public ContinuumPart {
   std::optional<coupling::OverlapZone> zone_;  // with a coupling section
   std::string overlap_where_;                  // "case.yaml:20", for errors about the overlap
   std::string quadrature_where_;               // the same for coupling.quadrature
+  std::string petsc_where_;                    // and for coupling.petsc_options
   coupling::CoupledOptions options_;
   std::unique_ptr<coupling::CoupledModel> coupled_;
   std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)

@@ -30,8 +30,8 @@
 //     weight: linear | cubic | constant   (constant_value: 0.5), mass_floor: 0.05
 //     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
 //     solver: petsc | direct   (the multiplier system A lambda = r: PETSc's KSP with
-//       petsc_options, default "-ksp_type preonly -pc_type cholesky", under the prefix
-//       coupling_; or our own sparse LDL^T, about 1 us per step cheaper on the wave bar)
+//       petsc_options, default "-ksp_type preonly -pc_type cholesky", in a database of their
+//       own; or our own sparse LDL^T)
 //     quadrature: plain | consistent   (consistent: the continuum's overlap weights are
 //       corrected so that a uniform stress leaves a lattice no ghost force,
 //       coupling/coupled_model.hpp; for overlaps whose free continuum nodes lie inside the

@@ -447,22 +447,17 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   check(MatNullSpaceCreateRigidBody(coords, &rigid), "MatNullSpaceCreateRigidBody");
   check(MatSetNearNullSpace(K, rigid), "MatSetNearNullSpace");
 
-  // The option string lives in its own options database, pushed while the solver is set up
-  // and run, so one solve's options never leak into another's.
-  PetscOptions db;
-  check(PetscOptionsCreate(&db), "PetscOptionsCreate");
-  check(PetscOptionsInsertString(db, ("-ksp_type cg -pc_type gamg -ksp_rtol 1e-12 " + petsc_options).c_str()),
-        "PETSc options");
-  check(PetscOptionsPush(db), "PetscOptionsPush");
   KSP ksp;
   KSPConvergedReason reason;
-  check(KSPCreate(comm, &ksp), "KSPCreate");
-  check(KSPSetOperators(ksp, K, K), "KSPSetOperators");
-  check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-  check(KSPSolve(ksp, b, x), "KSPSolve");
-  check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
-  check(PetscOptionsPop(), "PetscOptionsPop");
-  check(PetscOptionsDestroy(&db), "PetscOptionsDestroy");
+  {
+    // The option string in a database of its own while the solver is set up and run.
+    const ScopedPetscOptions options("-ksp_type cg -pc_type gamg -ksp_rtol 1e-12 " + petsc_options);
+    check(KSPCreate(comm, &ksp), "KSPCreate");
+    check(KSPSetOperators(ksp, K, K), "KSPSetOperators");
+    check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+    check(KSPSolve(ksp, b, x), "KSPSolve");
+    check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+  }
 
   // Every rank gets the whole solution.
   VecScatter to_all;

@@ -33,4 +33,35 @@ void petsc_check(int code, const char* what) {
   if (code != 0) throw RunError(std::string("PETSc failed in ") + what + " (error code " + std::to_string(code) + ")");
 }
 
+ScopedPetscOptions::ScopedPetscOptions(const std::string& options) {
+  petsc_check(PetscOptionsCreate(&db_), "PetscOptionsCreate");
+  if (const PetscErrorCode code = PetscOptionsInsertString(db_, options.c_str()); code != 0) {
+    PetscOptionsDestroy(&db_);
+    petsc_check(code, "PETSc options");
+  }
+  if (const PetscErrorCode code = PetscOptionsPush(db_); code != 0) {
+    PetscOptionsDestroy(&db_);
+    petsc_check(code, "PetscOptionsPush");
+  }
+}
+
+ScopedPetscOptions::~ScopedPetscOptions() {
+  PetscOptionsPop();
+  PetscOptionsDestroy(&db_);
+}
+
+std::string ScopedPetscOptions::unused() const {
+  PetscInt n = 0;
+  char **names = nullptr, **values = nullptr;
+  petsc_check(PetscOptionsLeftGet(db_, &n, &names, &values), "PetscOptionsLeftGet");
+  std::string list;
+  for (PetscInt i = 0; i < n; ++i) {
+    if (!list.empty()) list += ' ';
+    list += std::string("-") + names[i];
+    if (values[i]) list += std::string(" ") + values[i];
+  }
+  petsc_check(PetscOptionsLeftRestore(db_, &n, &names, &values), "PetscOptionsLeftRestore");
+  return list;
+}
+
 }  // namespace arlequin::continuum

@@ -6,6 +6,8 @@
 #pragma once
 #include <string>
 
+struct _n_PetscOptions;  // PETSc's PetscOptions is a pointer to it (petscoptions.h)
+
 namespace arlequin::continuum {
 
 class PetscSession {
@@ -20,5 +22,21 @@ class PetscSession {
 
 // Throws RunError naming `what` when a PETSc call returned an error code.
 void petsc_check(int code, const char* what);
+
+// The options of one PETSc solver, in a database of their own that is in force (pushed over
+// the global one) while this object lives: one solver's options never reach another's, nor do
+// the command line's reach it. Construct before the solver's SetFromOptions / SetUp calls.
+class ScopedPetscOptions {
+ public:
+  explicit ScopedPetscOptions(const std::string& options);  // RunError if PETSc cannot parse them
+  ~ScopedPetscOptions();
+  ScopedPetscOptions(const ScopedPetscOptions&) = delete;
+  ScopedPetscOptions& operator=(const ScopedPetscOptions&) = delete;
+  // The options nothing has read so far ("-name value" pairs, space-separated; "" if none).
+  std::string unused() const;
+
+ private:
+  ::_n_PetscOptions* db_ = nullptr;
+};
 
 }  // namespace arlequin::continuum

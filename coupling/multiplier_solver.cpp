@@ -43,13 +43,6 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     for (Eigen::Index r = 0; r < scale.size(); ++r)
       if (scale[r] == 0.0) Acol.coeffRef(r, r) = 1.0;
     nonzeros_ = Acol.nonZeros();
-    if (petsc) {
-      if (!ok) throw RunError("coupling: the multiplier matrix A has a negative or zero diagonal");
-      factor_of_[c] = static_cast<int>(scales_.size());
-      petsc_.push_back(std::make_unique<PetscSpdSolver>(Acol, *petsc));
-      scales_.push_back(scale);
-      continue;
-    }
     auto f = std::make_unique<Factor>();
     if (ok) f->compute(Acol);
     ok = ok && f->info() == Eigen::Success;
@@ -67,9 +60,13 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
           << "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, or mediator: fine)";
       throw RunError(msg.str());
     }
-    factor_of_[c] = static_cast<int>(factors_.size());
-    diagonals_.push_back(f->vectorD());
+    factor_of_[c] = static_cast<int>(scales_.size());
     scales_.push_back(scale);
+    if (petsc) {
+      petsc_.push_back(std::make_unique<PetscSpdSolver>(Acol, *petsc));
+      continue;
+    }
+    diagonals_.push_back(f->vectorD());
     factors_.push_back(std::move(f));
   }
 }

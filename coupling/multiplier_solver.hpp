@@ -22,8 +22,10 @@
 //  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
 //    the same Jacobi-scaled A, with the case's options: PETSc's way of choosing a solver at run
 //    time, e.g. an iterative one for a large overlap; the application's default, preonly +
-//    cholesky). Ours is about 1 us per step cheaper on the wave bar (cases/wave_bar_coupled/
-//    README.md).
+//    cholesky). Either way A is factored once by our LDL^T to check that it is positive
+//    definite (the RunError above), which PETSc's Cholesky (absolute zero-pivot test) or an
+//    iterative solve would not always tell. The two cost the same per step on the wave bar
+//    within the VM's noise (cases/wave_bar_coupled/README.md).
 #pragma once
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
@@ -45,7 +47,7 @@ class MultiplierSolver {
   // inv_mass_d: per coupled DE; inv_mass_c: per continuum dof (3 per node, node-major).
   // petsc: nullopt for our LDL^T, else PETSc with these options (empty: its defaults).
   MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
-                   const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc = std::nullopt);
+                   const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc);
 
   // A lambda = rhs per component (rhs, lambda: rows x 3).
   void solve(const Matrix3& rhs, Matrix3& lambda) const;
@@ -54,7 +56,8 @@ class MultiplierSolver {
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
-  int factorizations() const { return static_cast<int>(scales_.size()); }
+  // Distinct systems (one per distinct column of inverse masses; the others reuse one).
+  int systems() const { return static_cast<int>(scales_.size()); }
   // "LDL^T" or "PETSc <ksp> + <pc>".
   std::string backend() const;
   int rows() const { return ops_->rows(); }

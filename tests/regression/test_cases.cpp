@@ -303,7 +303,8 @@ TEST(Cases, LatticeBarFailsAtTheBondStrength) {
 
 // The multiplier solve is a runtime choice: PETSc's (default: preonly + cholesky; here also
 // an iterative one from the case's options) and our own LDL^T give R to 1e-9; options for the
-// direct solver are refused, and a PETSc solve that does not converge stops the run.
+// direct solver, an unknown type and an option nothing reads are refused (exit 2, naming the
+// key), and a PETSc solve that does not converge stops the run (exit 3).
 TEST(Cases, WaveBarCoupledMultiplierSolverIsARuntimeChoice) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -318,6 +319,13 @@ TEST(Cases, WaveBarCoupledMultiplierSolverIsARuntimeChoice) {
                                          " --set coupling.solver=direct --set coupling.petsc_options=-ksp_type");
   EXPECT_EQ(direct.exit_code, 2);
   EXPECT_NE(direct.output.find("coupling.petsc_options: is read by coupling.solver: petsc only"), std::string::npos) << direct.output;
+  for (const auto& [options, message] : std::vector<std::pair<std::string, std::string>>{
+           {"-ksp_type cgg", "PETSc refused '-ksp_type cgg'"}, {"-ksp_rtoll 1e-9", "PETSc did not use '-ksp_rtoll 1e-9'"}}) {
+    const auto bad = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() +
+                                        " --set 'coupling.petsc_options=\"" + options + "\"'");
+    EXPECT_EQ(bad.exit_code, 2) << options;
+    EXPECT_NE(bad.output.find("coupling.petsc_options: " + message), std::string::npos) << bad.output;
+  }
   const auto stalled = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() +
                                           " --set 'coupling.petsc_options=\"-ksp_type cg -pc_type none -ksp_max_it 2\"'");
   EXPECT_EQ(stalled.exit_code, 3);
