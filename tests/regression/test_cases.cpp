@@ -332,6 +332,19 @@ TEST(Cases, WaveBarCoupledMultiplierSolverIsARuntimeChoice) {
   EXPECT_NE(stalled.output.find("the multiplier solve did not converge (DIVERGED_ITS"), std::string::npos) << stalled.output;
 }
 
+// A coupled step above the smaller critical step of the two models is refused at set-up, with
+// the limit in the message (R6's stability point; runs at 0.9 of it: CouplingStability.*).
+TEST(Cases, WaveBarCoupledRefusesAStepAboveTheCriticalOne) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir(case_folder("wave_bar_coupled"));
+  const auto r = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() + " --set time.dt=1e-6");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("time.dt: time step 1e-06 s is above the critical time step"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("and the continuum); use dt <= "), std::string::npos) << r.output;
+}
+
 // R6 on a 3D bar: the pulse leaves the DEM through the overlap; the energy left behind is R.
 TEST(Cases, WaveBarCoupledTransmitsThePulse) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
