@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Shared by run.sh and test.sh: install the Debian packages if any is missing (needs root:
 # apt-get install), then configure and build into build/.
+# The list is everything a bare Debian 12 lacks for the build and the tests: the compiler and a
+# build program (make, which CMake's default generator drives), the libraries, gmsh for the
+# meshes, and openmpi-bin for mpirun (ContinuumMpi.MatchesSerial runs the static solve on 2 ranks).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-packages=(g++ cmake pkg-config zlib1g-dev libeigen3-dev petsc-dev libcgal-dev libgmsh-dev gmsh
-          libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev)
+packages=(g++ make cmake pkg-config zlib1g-dev libeigen3-dev petsc-dev openmpi-bin libcgal-dev
+          libgmsh-dev gmsh libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
@@ -16,8 +19,15 @@ if ((${#missing[@]})); then
     exit 1
   fi
   export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  log=$(mktemp)
+  # A failed install stops here: CMake never runs on a half-installed toolchain. apt's own
+  # output is kept in the log and its last lines shown, since they say why.
+  if ! { apt-get update -qq && apt-get install -y -qq --no-install-recommends "${missing[@]}"; } >"$log" 2>&1; then
+    tail -n 5 "$log" >&2
+    echo "setup: apt-get could not install: ${missing[*]} (full apt output: $log)" >&2
+    exit 1
+  fi
+  rm -f "$log"
 fi
 jobs=$(nproc)
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
