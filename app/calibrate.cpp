@@ -11,7 +11,7 @@
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
-#include "common/png_plot.hpp"
+#include "common/plots.hpp"
 
 namespace arlequin::app {
 
@@ -62,26 +62,24 @@ Json estimate_json(const Estimate& e) {
   j["uncertainty"] = e.uncertainty;
   return j;
 }
-Estimate read_estimate(const Json& j) { return {j.at("value").as_number(), j.at("uncertainty").as_number()}; }
+Estimate read_estimate(const Json& j) { return {j.at("value").get<double>(), j.at("uncertainty").get<double>()}; }
 
 // The cache of curve points next to the sample: {"entries": [{"signature", "points": [...]}]}.
 class CurveCache {
  public:
   CurveCache(std::filesystem::path file, std::string signature) : file_(std::move(file)), signature_(std::move(signature)) {
     if (std::filesystem::exists(file_)) {
-      std::ifstream in(file_);
-      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
       try {
-        document_ = Json::parse(text);
+        document_ = read_json_file(file_);
       } catch (const InputError&) {
         std::fprintf(stderr, "calibrate: ignoring an unreadable cache %s\n", file_.string().c_str());
       }
     }
-    if (!document_.find("entries")) document_ = Json::object(), document_["entries"] = Json::array();
+    if (!document_.is_object() || !document_.contains("entries")) document_ = Json::object(), document_["entries"] = Json::array();
   }
   std::optional<CurvePoint> find(double r_mu) const {
     for (const Json& p : points())
-      if (p.at("r_mu").as_number() == r_mu)
+      if (p.at("r_mu").get<double>() == r_mu)
         return CurvePoint{r_mu, read_estimate(p.at("young_per_E_mu")), read_estimate(p.at("poisson")), "cache"};
     return std::nullopt;
   }
@@ -92,9 +90,9 @@ class CurveCache {
     p["poisson"] = estimate_json(point.poisson);
     Json entries = Json::array();
     bool stored = false;
-    for (const Json& e : document_.at("entries").as_array()) {
+    for (const Json& e : document_.at("entries")) {
       Json copy = e;
-      if (e.at("signature").as_string() == signature_) copy["points"].push_back(p), stored = true;
+      if (e.at("signature").get<std::string>() == signature_) copy["points"].push_back(p), stored = true;
       entries.push_back(copy);
     }
     if (!stored) {
@@ -109,10 +107,10 @@ class CurveCache {
   const std::filesystem::path& file() const { return file_; }
 
  private:
-  const Json::Array& points() const {
-    static const Json::Array none;
-    for (const Json& e : document_.at("entries").as_array())
-      if (e.at("signature").as_string() == signature_) return e.at("points").as_array();
+  const Json& points() const {
+    static const Json none = Json::array();
+    for (const Json& e : document_.at("entries"))
+      if (e.at("signature").get<std::string>() == signature_) return e.at("points");
     return none;
   }
   std::filesystem::path file_;
@@ -177,18 +175,22 @@ void write_strengths(const CalibrationResult& result, const std::filesystem::pat
 void write_elastic(const CalibrationSpec& spec, const CalibrationResult& result, const std::filesystem::path& out_dir, std::string& md,
                    Json& summary) {
   std::string csv = "r_mu,E_M_per_E_mu,E_M_per_E_mu_u,nu_M,nu_M_u,source\n";
-  PlotSeries nu{"nu_M", {}, {}, PlotSeries::Style::line_points}, young{"E_M / E_mu", {}, {}, PlotSeries::Style::line_points, true};
-  for (const auto& p : result.curve) {
+  for (const auto& p : result.curve)
     csv += format("%.9g", p.r_mu) + "," + format("%.9g", p.young_per_E_mu.value) + "," + format("%.3g", p.young_per_E_mu.uncertainty) +
            "," + format("%.9g", p.poisson.value) + "," + format("%.3g", p.poisson.uncertainty) + "," + p.source + "\n";
-    nu.x.push_back(p.r_mu), nu.y.push_back(p.poisson.value);
-    young.x.push_back(p.r_mu), young.y.push_back(p.young_per_E_mu.value);
-  }
   write_file_atomically(out_dir / "curve.csv", csv);
-  PlotSeries chosen{"calibrated (r_mu, nu_M)", {}, {}, PlotSeries::Style::points};
+  PlotCurve chosen{.label = "calibrated (r_mu, nu_M)", .style = PlotCurve::Style::points};
   for (const auto& pair : result.pairs) chosen.x.push_back(pair.r_mu), chosen.y.push_back(pair.achieved.front().poisson.value);
-  write_png_plot(out_dir / "curve.png", PlotSpec{"Calibration curve: tension tests at E_mu = 1 Pa", "r_mu", "nu_M", "E_M / E_mu",
-                                                 {nu, young, chosen}});
+  const auto curve_column = [](std::string column, std::string label, bool right) {
+    return PlotCurve{.label = std::move(label), .style = PlotCurve::Style::line_points, .right_axis = right, .csv = "curve.csv",
+                     .x_column = "r_mu", .y_column = std::move(column)};
+  };
+  write_plots(out_dir, {Plot{.file = "curve.png",
+                             .title = "Calibration curve: tension tests at E_mu = 1 Pa",
+                             .x_label = "r_mu",
+                             .y_label = "nu_M",
+                             .y2_label = "E_M / E_mu",
+                             .curves = {curve_column("nu_M", "nu_M", false), curve_column("E_M_per_E_mu", "E_M / E_mu", true), chosen}}});
 
   md +=
       "| material | target E_M GPa | target nu_M | E_mu GPa | r_mu | sample | DEs | achieved E_M GPa | E_M error | achieved nu_M | "

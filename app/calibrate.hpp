@@ -1,6 +1,6 @@
 // Calibration of beam-bond micro parameters (E_mu, r_mu) against macroscopic elastic targets
-// (E_M, nu_M) with quasi-static virtual tensile tests (DESIGN.md section 3; seed Table 1,
-// REFERENCE.md R2; Andre, Iordanoff, Charles, Neauport, CMAME 213-216 (2012) 113, section 4):
+// (E_M, nu_M) with quasi-static virtual tensile tests (docs/theory.md#calibration; seed Table 1,
+// docs/validation.md R2; docs/references.md#andre2012, section 4):
 // on a given packing, nu_M depends (almost) only on r_mu, and at fixed r_mu the bond forces,
 // hence E_M, are proportional to E_mu. So:
 //  1. the calibration curve: tension tests (virtual_tests.hpp) at E_mu = 1 Pa over a grid of
@@ -16,7 +16,7 @@
 // next to the sample file (calibration_cache.json), keyed by the case as resolved and the test
 // plan, so a second calibration on the same packing only runs what is new.
 //
-// Failure calibration (DESIGN.md section 3; seed Table 1's sigma_f_mu): at fixed elastic
+// Failure calibration (docs/theory.md#calibration; seed Table 1's sigma_f_mu): at fixed elastic
 // micro parameters the sample's macroscopic tensile failure stress is proportional to the
 // micro strength (every bond force scales with it up to the first break, and the cascade after
 // it is the same in units of the failure strain), so, from a first guess s_0, tests to failure

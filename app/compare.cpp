@@ -13,7 +13,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
-#include "common/png_plot.hpp"
+#include "common/plots.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -61,17 +61,17 @@ Run execute(Prepared& prepared, const std::filesystem::path& out) {
   run.particles = scene.dem.particles.size();
   Json counts = Json::object();
   if (scene.continuum) scene.continuum->describe(counts);
-  if (const Json* n = counts.find("continuum_nodes")) run.nodes = long(n->as_integer());
+  run.nodes = counts.value("continuum_nodes", 0L);
   try {
     run_scene(scene, run_options);
   } catch (const RunError&) {
     run.ok = false;
   }
-  const Json summary = Json::parse(read_text_file(out / "summary.json"));
+  const Json summary = read_json_file(out / "summary.json");
   run.setup = run_options.setup_seconds;
-  run.loop = summary.at("wall_time").at("time_loop").as_number();
-  run.output = summary.at("wall_time").at("output").as_number();
-  run.steps = long(summary.at("steps").as_integer());
+  run.loop = summary.at("wall_time").at("time_loop").get<double>();
+  run.output = summary.at("wall_time").at("output").get<double>();
+  run.steps = long(summary.at("steps").get<std::int64_t>());
   // series.csv: a header, then rows of numbers.
   std::stringstream csv(read_text_file(out / "series.csv"));
   std::string line;
@@ -140,6 +140,7 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   const auto ta = a.column("time"), tb = b.column("time");
   Json sensors = Json::array();
   std::string csv = "sensor,max_relative_difference,rms_relative_difference\n";
+  std::vector<Plot> plots;
   std::printf("| sensor | max rel. difference | RMS rel. difference |\n|---|---|---|\n");
   for (const std::string& name : shared) {
     const auto va = a.column(name), vb = resample(tb, b.column(name), ta);
@@ -161,12 +162,14 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
     std::snprintf(row, sizeof row, "%s,%.6g,%.6g\n", name.c_str(), max_rel, rms_rel);
     csv += row;
     std::printf("| %s | %.3g %% | %.3g %% |\n", name.c_str(), 100 * max_rel, 100 * rms_rel);
-    PlotSpec plot;
+    Plot& plot = plots.emplace_back();
+    plot.file = "compare_" + name + ".png";
     plot.title = name + ": " + b.name + " against " + a.name;
     plot.x_label = "time [s]";
     plot.y_label = name;
-    plot.series = {{a.name, ta, va}, {b.name, tb, b.column(name)}};
-    write_png_plot(out_dir / ("compare_" + name + ".png"), plot);
+    plot.curves.resize(2);
+    plot.curves[0].label = a.name, plot.curves[0].x = ta, plot.curves[0].y = va;
+    plot.curves[1].label = b.name, plot.curves[1].x = tb, plot.curves[1].y = b.column(name);
   }
   const double speedup = a.compute_seconds() / std::max(b.compute_seconds(), 1e-12);
   std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", a.name.c_str(),
@@ -182,6 +185,7 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   report["sensors"] = sensors;
   write_file_atomically(out_dir / "compare.csv", csv);
   write_json_atomically(out_dir / "compare.json", report);
+  write_plots(out_dir, plots);
   return a.ok && b.ok;
 }
 

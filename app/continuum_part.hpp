@@ -47,6 +47,7 @@
 #include <optional>
 #include <string>
 
+#include "common/json.hpp"
 #include "common/vec3.hpp"
 
 namespace arlequin {
@@ -55,7 +56,6 @@ namespace dem {
 class DemModel;
 }
 class FieldsWriter;
-class Json;
 namespace continuum {
 class ContinuumSolver;
 }

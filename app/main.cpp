@@ -21,6 +21,8 @@
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
+#include "dem/bonds/bond_set.hpp"
+#include "dem/contacts/contact_law.hpp"
 
 namespace {
 
@@ -39,6 +41,7 @@ constexpr const char* usage_main =
     "  calibrate SPEC.yaml      fit beam bonds (E_mu, r_mu) to a material's (E_M, nu_M) on a packing,\n"
     "                           and BBF / RDEF strengths to its tensile failure stress\n"
     "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
+    "  laws                     list the bond and contact laws (dem.material.bond.law, dem.contact.law)\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -110,7 +113,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare", "virtual-test", "calibrate"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare", "virtual-test", "calibrate", "laws"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -118,7 +121,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare, virtual-test, calibrate"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare, virtual-test, calibrate, laws"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -155,11 +158,21 @@ Arguments parse(int argc, char** argv) {
       throw InputError("arlequin " + a.command + ": unknown option '" + arg + "' (see arlequin " + a.command + " --help)");
     }
   }
-  if (!a.help && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
+  if (a.command == "laws" && !a.case_file.empty()) throw InputError("arlequin laws: takes no case file");
+  if (!a.help && a.command != "laws" && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
   if (!a.help && a.command == "compare" && a.second_case.empty())
     throw InputError("arlequin compare: give two case files (the reference first)");
   if (!a.help && a.command == "sweep" && a.axes.empty()) throw InputError("arlequin sweep: give at least one --over key=v1,v2");
   return a;
+}
+
+// The registries' rows: each law's case-file name and one-line summary.
+int list_laws() {
+  std::printf("bond laws (dem.material.bond.law):\n");
+  for (const auto& law : dem::bond_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  std::printf("contact laws (dem.contact.law):\n");
+  for (const auto& law : dem::contact_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  return 0;
 }
 
 void print_scene_facts(const app::Scene& scene) {
@@ -319,6 +332,7 @@ int main(int argc, char** argv) {
     if (a.command == "virtual-test") return virtual_test(a);
     if (a.command == "calibrate") return calibrate(a);
     if (a.command == "compare") return compare(a);
+    if (a.command == "laws") return list_laws();
     return check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());

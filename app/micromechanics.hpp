@@ -1,5 +1,5 @@
 // Closed-form elastic moduli of a unidirectional fibre composite with isotropic phases: the
-// "theory" row of REFERENCE.md R3 (seed Table 3), against which DEM REV tests are judged.
+// "theory" row of docs/validation.md R3 (seed Table 3), against which DEM REV tests are judged.
 //
 // Contract: fibre and matrix are isotropic and linear elastic (E > 0, -1 < nu < 0.5), the
 // fibre volume fraction is in [0, 1]; any consistent unit for the moduli (the results are

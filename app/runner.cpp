@@ -16,7 +16,7 @@
 #include "common/fields_writer.hpp"
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
-#include "common/png_plot.hpp"
+#include "common/plots.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -123,26 +123,31 @@ class Outputs {
   }
   const CsvSeries& series() const { return *series_; }
 
-  // The case's plots of series columns (after the last row).
+  // The case's plots of series.csv columns, drawn once the file is complete.
   void write_plots() const {
-    const auto& columns = series_->columns();
-    const auto column = [&](const std::string& name, double scale) {
-      const std::size_t c = std::find(columns.begin(), columns.end(), name) - columns.begin();
-      std::vector<double> v;
-      for (std::size_t r = 0; r < series_->rows() && c < columns.size(); ++r) v.push_back(scale * series_->row(r)[c]);
-      return v;
-    };
+    std::vector<Plot> plots;
     for (const PlotPlan& plan : scene_.output.plots) {
-      PlotSpec spec;
-      spec.title = plan.title;
-      spec.x_label = plan.x_label;
-      spec.y_label = plan.y_label;
-      spec.y2_label = plan.y2_label;
-      const auto x = column(plan.x, plan.x_scale);
-      for (const auto& y : plan.y) spec.series.push_back({y, x, column(y, plan.y_scale)});
-      for (const auto& y : plan.y2) spec.series.push_back({y, x, column(y, plan.y2_scale), PlotSeries::Style::line, true});
-      write_png_plot(scene_.output.dir / plan.file, spec);
+      Plot& plot = plots.emplace_back();
+      plot.file = plan.file.string();
+      plot.title = plan.title;
+      plot.x_label = plan.x_label;
+      plot.y_label = plan.y_label;
+      plot.y2_label = plan.y2_label;
+      const auto curve = [&](const std::string& y, double y_scale, bool right) {
+        PlotCurve c;
+        c.label = y;
+        c.right_axis = right;
+        c.csv = "series.csv";
+        c.x_column = plan.x;
+        c.y_column = y;
+        c.x_scale = plan.x_scale;
+        c.y_scale = y_scale;
+        return c;
+      };
+      for (const auto& y : plan.y) plot.curves.push_back(curve(y, plan.y_scale, false));
+      for (const auto& y : plan.y2) plot.curves.push_back(curve(y, plan.y2_scale, true));
     }
+    arlequin::write_plots(scene_.output.dir, plots);
   }
 
  private:
@@ -412,11 +417,11 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     interrupted = std::current_exception();
   }
   progress.finish();
-  outputs.write_plots();
   result.steps = steps_done;
   result.simulated_time = current_time();
   result.wall_seconds = seconds_since(t_start);
   outputs.close();
+  outputs.write_plots();
 
   Json summary = Json::object();
   summary["name"] = scene.name;

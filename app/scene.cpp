@@ -550,8 +550,9 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
     for (CaseNode p : out->list_or_empty("plots")) {
       PlotPlan plot;
       plot.file = p.string("file");
-      if (plot.file.extension() != ".png" || plot.file.has_parent_path())
-        p.fail("file", "expected a file name ending in .png (written in the output folder)");
+      const auto ext = plot.file.extension();
+      if ((ext != ".png" && ext != ".svg" && ext != ".pdf") || plot.file.has_parent_path())
+        p.fail("file", "expected a file name ending in .png, .svg or .pdf (written in the output folder)");
       plot.title = p.string_or("title", "");
       plot.x = p.string("x");
       plot.x_scale = p.number_or("x_scale", 1.0, Range::any(), "1");

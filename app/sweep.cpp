@@ -9,7 +9,7 @@
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
-#include "common/png_plot.hpp"
+#include "common/plots.hpp"
 
 namespace arlequin::app {
 
@@ -41,7 +41,7 @@ namespace {
 
 // sweep.png: the first check's value against the first axis when its values are numbers (one
 // line per combination of the other axes), else against the wall time (one point per run).
-void plot_sweep(const std::filesystem::path& file, const std::vector<SweepAxis>& axes,
+void plot_sweep(const std::filesystem::path& dir, const std::vector<SweepAxis>& axes,
                 const std::vector<std::vector<std::string>>& picked, const std::vector<double>& value,
                 const std::vector<double>& wall, const std::string& check) {
   std::vector<double> first(picked.size());
@@ -51,7 +51,8 @@ void plot_sweep(const std::filesystem::path& file, const std::vector<SweepAxis>&
     first[r] = std::strtod(picked[r][0].c_str(), &end);
     numeric = numeric && end != picked[r][0].c_str() && *end == '\0';
   }
-  PlotSpec spec;
+  Plot spec;
+  spec.file = "sweep.png";
   spec.title = "arlequin sweep: " + check;
   spec.y_label = check + " (checked value)";
   spec.x_label = numeric ? axes[0].key : "wall time (s)";
@@ -64,14 +65,16 @@ void plot_sweep(const std::filesystem::path& file, const std::vector<SweepAxis>&
     auto it = std::find(labels.begin(), labels.end(), label);
     if (it == labels.end()) {
       labels.push_back(label);
-      spec.series.push_back({label, {}, {}, numeric ? PlotSeries::Style::line_points : PlotSeries::Style::points});
+      PlotCurve& curve = spec.curves.emplace_back();
+      curve.label = label;
+      curve.style = numeric ? PlotCurve::Style::line_points : PlotCurve::Style::points;
       it = labels.end() - 1;
     }
-    PlotSeries& series = spec.series[it - labels.begin()];
+    PlotCurve& series = spec.curves[it - labels.begin()];
     series.x.push_back(numeric ? first[r] : wall[r]);
     series.y.push_back(value[r]);
   }
-  write_png_plot(file, spec);
+  write_plots(dir, {spec});
 }
 
 struct SweepRow {
@@ -155,7 +158,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
       }
     }
     write_file_atomically(out_dir / "sweep.csv", csv);
-    if (!picked.empty()) plot_sweep(out_dir / "sweep.png", axes, picked, first_value, wall, check_names[0]);
+    if (!picked.empty()) plot_sweep(out_dir, axes, picked, first_value, wall, check_names[0]);
   };
   bool all_ok = true;
   for (std::size_t run = 0; run < runs; ++run) {
@@ -179,7 +182,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
       Json counts = Json::object();
       if (scene.continuum) scene.continuum->describe(counts);
       row.particles = scene.dem.particles.size();
-      row.nodes = counts.find("continuum_nodes") ? long(counts.at("continuum_nodes").as_integer()) : 0;
+      row.nodes = counts.value("continuum_nodes", 0L);
       row.status = "stopped";
       const RunResult r = run_scene(scene, run_options);
       row.steps = r.steps;

@@ -226,7 +226,7 @@ constexpr const char* constant_keys[] = {"E_L", "E_T", "nu_LT", "nu_TT", "G_LT",
 using Constants = std::array<double, 6>;
 bool is_poisson(std::size_t c) { return c == 2 || c == 3; }
 
-// A unidirectional composite (REFERENCE.md R3): its phases, the closed forms and reference rows.
+// A unidirectional composite (docs/validation.md R3): its phases, the closed forms and reference rows.
 struct CompositeSpec {
   IsotropicPhase fibre{}, matrix{};
   double fraction = 0.0;

@@ -1,6 +1,6 @@
 // Quasi-static virtual material tests on a DEM sample: tension and simple shear of a box-shaped
 // sample, the seed's "first challenge" (homogenised moduli of a REV, seed Fig. 3 and Table 3;
-// REFERENCE.md R2, R3), and the suites of them that `arlequin virtual-test` runs.
+// docs/validation.md R2, R3), and the suites of them that `arlequin virtual-test` runs.
 //
 // A test is the sample case (dem sample, materials or bond law; no groups, boundary or sensors
 // of its own) plus generated sections (`--set` overrides):

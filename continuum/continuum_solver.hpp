@@ -17,7 +17,7 @@
 //    tractions on named boundary groups, integrated with the method's own shape functions and
 //    surface rule (`surface_rule`).
 //  - Explicit central difference = velocity Verlet: kick(dt/2), drift(dt), compute_forces(),
-//    kick(dt/2) (`step`). The coupled step of DESIGN section 2 calls the three parts itself.
+//    kick(dt/2) (`step`). The coupled step (docs/theory.md#coupled-step) calls the three parts itself.
 //    Stable for dt < critical_time_step() = 2 / omega_max of M^-1 K (power iteration).
 //  - `solve_static` assembles K into a PETSc Mat distributed over PETSC_COMM_WORLD (each rank
 //    adds its share of the integration points; one rank when run without mpirun) and solves

@@ -1,5 +1,5 @@
 // CoupledModel: a DEM model and a continuum coupled by the Arlequin method with velocity
-// multipliers, advanced by one explicit velocity-Verlet step (DESIGN.md section 2).
+// multipliers, advanced by one explicit velocity-Verlet step (docs/theory.md#coupled-step).
 //
 // Contract
 //  - Construction takes a DemModel that is built (DEs, bonds, boundary conditions) but NOT
@@ -50,7 +50,7 @@
 //      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt, and the work
 //         of the multiplier forces over the drift (from the residual of the drift velocities
 //         of step 2)
-//    Steps 3-5 are DESIGN.md section 2 steps 3-5; step 1 is the same constraint force applied
+//    Steps 3-5 are the constrained velocity-Verlet correction; step 1 is the same constraint force applied
 //    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
 //  - critical_time_step() = min(DEM, continuum): the constrained system's highest frequency
 //    is at most the larger of the two (Rayleigh quotient over a subspace).

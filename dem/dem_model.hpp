@@ -1,5 +1,5 @@
 // The DEM model: particles, bond batches, optional contact, boundary conditions, and the
-// explicit velocity-Verlet step with rotations (DESIGN.md section 2).
+// explicit velocity-Verlet step with rotations (docs/theory.md#step).
 //
 // Contract: build with add_group / add_bond_set / set_contact / add_boundary / set_damping,
 // then finalize() once (checks boundary conditions, colours bonds, builds the neighbour list
@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "dem/bond_set.hpp"
+#include "dem/bonds/bond_set.hpp"
 #include "dem/boundary.hpp"
-#include "dem/contact_law.hpp"
+#include "dem/contacts/contact_law.hpp"
 #include "dem/failure.hpp"
 #include "dem/neighbour_list.hpp"
 #include "dem/particles.hpp"
@@ -57,7 +57,7 @@ class DemModel {
   // Reaction forces of this group are recorded every step (for force sensors).
   void watch_reaction(int group) { watched_ |= GroupMask{1} << group; }
 
-  // Arlequin weighting (DESIGN.md section 2): every DE's mass (and so its inertia) is
+  // Arlequin weighting (docs/theory.md#weighted-models): every DE's mass (and so its inertia) is
   // multiplied by max(alpha(x_i), mass_floor), every bond's stiffness by alpha at its
   // midpoint. Call once, after the bonds are added and before finalize(). Contacts are not
   // weighted (a coupled zone is bonded).
@@ -85,7 +85,7 @@ class DemModel {
   void finalize();
 
   // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
-  // bonds and contacts (DESIGN.md section 3). Contacts count as many per DE as it has
+  // bonds and contacts (docs/theory.md#critical-step). Contacts count as many per DE as it has
   // neighbours at setup (at least one), with the stiffness of the contact law.
   double critical_time_step() const;
 

@@ -1,5 +1,5 @@
 // Dense random packings of spherical DEs in a region: the seed's "first challenge"
-// (DESIGN.md section 3). Radii follow a truncated Gaussian; as many DEs as the target
+// (docs/theory.md#packing). Radii follow a truncated Gaussian; as many DEs as the target
 // compaction needs are inserted at random at reduced size, then grown to full size in steps
 // with the overlaps relaxed after each (athermal compression to just below jamming). Every
 // pair closer than (R_i + R_j)(1 + bond_tolerance) counts as a bond for the coordination.

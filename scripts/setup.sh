@@ -3,11 +3,13 @@
 # apt-get install), then configure and build into build/.
 # The list is everything a bare Debian 12 lacks for the build and the tests: the compiler and a
 # build program (make, which CMake's default generator drives), the libraries, gmsh for the
-# meshes, and openmpi-bin for mpirun (ContinuumMpi.MatchesSerial runs the static solve on 2 ranks).
+# meshes, openmpi-bin for mpirun (ContinuumMpi.MatchesSerial runs the static solve on 2 ranks),
+# and Python with matplotlib, pandas, h5py and pytest for the plots and their tests (python/).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-packages=(g++ make cmake pkg-config zlib1g-dev libeigen3-dev petsc-dev openmpi-bin libcgal-dev
-          libgmsh-dev gmsh libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev)
+packages=(g++ make cmake pkg-config libeigen3-dev petsc-dev openmpi-bin libcgal-dev
+          libgmsh-dev gmsh libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev nlohmann-json3-dev
+          python3 python3-matplotlib python3-numpy python3-pandas python3-h5py python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")

@@ -16,7 +16,7 @@
 #include "continuum/registry.hpp"
 #include "coupling/coupled_model.hpp"
 #include "dem/dem_model.hpp"
-#include "dem/spring_bond.hpp"
+#include "dem/bonds/spring_bond.hpp"
 
 namespace arlequin::coupling::testing {
 

@@ -1,4 +1,4 @@
-// Static patch tests of the coupling (REFERENCE.md R6): the coupling operators see no mismatch in
+// Static patch tests of the coupling (docs/validation.md R6): the coupling operators see no mismatch in
 // an affine field, and a coupled model started on a uniform strain stays on it (no spurious
 // forces in the overlap).
 #include <gtest/gtest.h>

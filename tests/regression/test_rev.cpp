@@ -1,5 +1,5 @@
 // Virtual material tests, the calibration of beam bonds and the composite REV
-// (app/virtual_tests.hpp, app/calibrate.hpp, cases/rev_elastic; REFERENCE.md R2, R3).
+// (app/virtual_tests.hpp, app/calibrate.hpp, cases/rev_elastic; docs/validation.md R2, R3).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -136,9 +136,9 @@ TEST(Runs, BondedPackingAtRestRunsToTheEnd) {
   homogeneous_case(dir);
   const auto r = test::run_arlequin("run " + (dir / "sample.yaml").string() + " --set time.end=2e-5 --out " + (dir / "out").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json summary = Json::parse(test::read_text(dir / "out" / "summary.json"));
-  EXPECT_EQ(summary.at("status").as_string(), "completed");
-  EXPECT_LT(summary.at("energies").at("kinetic").as_number(), 1e-24);
+  const Json summary = read_json_file(dir / "out" / "summary.json");
+  EXPECT_EQ(summary.at("status").get<std::string>(), "completed");
+  EXPECT_LT(summary.at("energies").at("kinetic").get<double>(), 1e-24);
 }
 
 // The same packing at rest with a step above the stability limit (forced past the input check):
@@ -204,11 +204,11 @@ TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   for (const char* f : {"curve.csv", "curve.png", "calibration.md", "calibration.json"})
     EXPECT_TRUE(std::filesystem::exists(dir / "a" / f)) << f;
   EXPECT_TRUE(std::filesystem::exists(dir / "calibration_cache.json"));  // next to the sample
-  const Json pair = Json::parse(test::read_text(dir / "a" / "calibration.json")).at("pairs").as_array().at(0);
-  const Json& achieved = pair.at("achieved").as_array().at(0);
-  EXPECT_NEAR(achieved.at("E_M").at("value").as_number(), 3.45e9, 0.05 * 3.45e9);
-  EXPECT_NEAR(achieved.at("nu_M").at("value").as_number(), 0.3, 0.02);
-  const double r_mu = pair.at("r_mu").as_number();
+  const Json pair = read_json_file(dir / "a" / "calibration.json").at("pairs").at(0);
+  const Json& achieved = pair.at("achieved").at(0);
+  EXPECT_NEAR(achieved.at("E_M").at("value").get<double>(), 3.45e9, 0.05 * 3.45e9);
+  EXPECT_NEAR(achieved.at("nu_M").at("value").get<double>(), 0.3, 0.02);
+  const double r_mu = pair.at("r_mu").get<double>();
   EXPECT_GT(r_mu, 0.2);
   EXPECT_LT(r_mu, 0.4);
   EXPECT_GE(test::read_csv(dir / "a" / "curve.csv").size(), 3u);
@@ -217,8 +217,8 @@ TEST(Calibration, CoarseCurveHitsTheTargetAndIsCached) {
   ASSERT_EQ(second.exit_code, 0) << second.output;
   EXPECT_EQ(second.output.find("(grid)"), std::string::npos) << second.output;
   EXPECT_EQ(second.output.find("(refinement)"), std::string::npos) << second.output;
-  const Json again = Json::parse(test::read_text(dir / "b" / "calibration.json")).at("pairs").as_array().at(0);
-  EXPECT_EQ(again.at("r_mu").as_number(), r_mu);
+  const Json again = read_json_file(dir / "b" / "calibration.json").at("pairs").at(0);
+  EXPECT_EQ(again.at("r_mu").get<double>(), r_mu);
 }
 
 // Failure calibration (issue: REV failure): BBF and RDEF strengths of the epoxy pair reproduce
@@ -235,11 +235,11 @@ TEST(Calibration, StrengthsReproduceTheTargetFailureStress) {
   const auto r = test::run_arlequin("calibrate " + (dir / "strength.yaml").string() + " --out " + (dir / "out").string(), "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (const char* f : {"strength.csv", "calibration.md", "calibration.json"}) EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
-  const Json strengths = Json::parse(test::read_text(dir / "out" / "calibration.json")).at("strengths");
-  ASSERT_EQ(strengths.as_array().size(), 2u);
-  for (const Json& s : strengths.as_array()) {
-    EXPECT_TRUE(s.at("converged").as_bool());
-    EXPECT_NEAR(s.at("failure_stress").as_number(), 7.0e7, 0.05 * 7.0e7) << s.at("criterion").as_string();
+  const Json strengths = read_json_file(dir / "out" / "calibration.json").at("strengths");
+  ASSERT_EQ(strengths.size(), 2u);
+  for (const Json& s : strengths) {
+    EXPECT_TRUE(s.at("converged").get<bool>());
+    EXPECT_NEAR(s.at("failure_stress").get<double>(), 7.0e7, 0.05 * 7.0e7) << s.at("criterion").get<std::string>();
   }
   // Every round: stress / threshold within 25 % of the first round's (near proportionality).
   const auto rounds = test::read_csv(dir / "out" / "strength.csv");
@@ -288,9 +288,9 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
     EXPECT_NEAR(test::number(row, "failure_stress"), 1.30e9, 0.3 * 1.30e9) << test;
     EXPECT_GT(test::number(row, "fracture_energy"), 0.0) << test;
     const auto run = dir / "out" / "rev_10k" / test;
-    const Json j = Json::parse(test::read_text(run / "test.json"));
-    for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GE(j.at("broken_at_end").at(set).as_number(), 0.0) << set;
-    EXPECT_GT(j.at("broken_at_end").at("fibre").as_number(), j.at("broken_at_peak").at("fibre").as_number()) << test;
+    const Json j = read_json_file(run / "test.json");
+    for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GE(j.at("broken_at_end").at(set).get<double>(), 0.0) << set;
+    EXPECT_GT(j.at("broken_at_end").at("fibre").get<double>(), j.at("broken_at_peak").at("fibre").get<double>()) << test;
     for (const char* f : {"failure.png", "fields.xdmf", "breaks.csv"}) EXPECT_TRUE(std::filesystem::exists(run / f)) << test << " " << f;
   }
 }
@@ -447,19 +447,19 @@ TEST(ValidationRev, CalibrationReproducesTable1Materials) {
         spec + "verify: [{name: seed_8, set: [\"name=rev_homogeneous_10k_seed8\", \"dem.sample.seed=8\"]}]\n");
   const auto r = test::run_arlequin("calibrate " + (dir / "calibration.yaml").string() + " --out " + (dir / "out").string(), "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json pairs = Json::parse(test::read_text(dir / "out" / "calibration.json")).at("pairs");
-  ASSERT_EQ(pairs.as_array().size(), 2u);
+  const Json pairs = read_json_file(dir / "out" / "calibration.json").at("pairs");
+  ASSERT_EQ(pairs.size(), 2u);
   CaseFile rev = CaseFile::load(rev_case / "case.yaml");
   CaseNode materials = rev.root().child("dem").child("materials");
-  for (const Json& pair : pairs.as_array()) {
-    for (const Json& a : pair.at("achieved").as_array()) {
-      const double E = pair.at("target_E_M").as_number();
-      EXPECT_NEAR(a.at("E_M").at("value").as_number(), E, 0.05 * E) << pair.at("name").as_string() << " " << a.at("sample").as_string();
-      EXPECT_NEAR(a.at("nu_M").at("value").as_number(), 0.3, 0.02) << pair.at("name").as_string() << " " << a.at("sample").as_string();
+  for (const Json& pair : pairs) {
+    for (const Json& a : pair.at("achieved")) {
+      const double E = pair.at("target_E_M").get<double>();
+      EXPECT_NEAR(a.at("E_M").at("value").get<double>(), E, 0.05 * E) << pair.at("name").get<std::string>() << " " << a.at("sample").get<std::string>();
+      EXPECT_NEAR(a.at("nu_M").at("value").get<double>(), 0.3, 0.02) << pair.at("name").get<std::string>() << " " << a.at("sample").get<std::string>();
     }
-    CaseNode bond = materials.child_named(pair.at("name").as_string() == "carbon_fibre" ? "fibre" : "matrix").child("bond");
-    EXPECT_NEAR(bond.number("E_mu", Range::positive(), "Pa"), pair.at("E_mu").as_number(), 0.01 * pair.at("E_mu").as_number());
-    EXPECT_NEAR(bond.number("r_mu", Range::positive(), "1"), pair.at("r_mu").as_number(), 0.001);
+    CaseNode bond = materials.child_named(pair.at("name").get<std::string>() == "carbon_fibre" ? "fibre" : "matrix").child("bond");
+    EXPECT_NEAR(bond.number("E_mu", Range::positive(), "Pa"), pair.at("E_mu").get<double>(), 0.01 * pair.at("E_mu").get<double>());
+    EXPECT_NEAR(bond.number("r_mu", Range::positive(), "1"), pair.at("r_mu").get<double>(), 0.001);
   }
 }
 

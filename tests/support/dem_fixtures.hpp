@@ -3,7 +3,7 @@
 #include <memory>
 #include <numbers>
 
-#include "dem/beam_bond.hpp"
+#include "dem/bonds/beam_bond.hpp"
 #include "dem/dem_model.hpp"
 #include "dem/samples.hpp"
 

@@ -1,5 +1,5 @@
 // Arlequin weighting of the DEM side: masses by max(alpha, floor) at the DE, bond stiffness
-// by alpha at the bond midpoint (DESIGN.md section 2).
+// by alpha at the bond midpoint (docs/theory.md#weighted-models).
 #include <gtest/gtest.h>
 
 #include "support/dem_fixtures.hpp"

@@ -1,11 +1,11 @@
-// R1 (REFERENCE.md): single beam bond responses against the closed forms of a linear
+// R1 (docs/validation.md): single beam bond responses against the closed forms of a linear
 // Euler-Bernoulli beam element, to 1e-9 relative. Small displacements (1e-5 of L) keep the
 // geometric non-linearity (O(d^2/L^2)) and the round-off well below that.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "dem/spring_bond.hpp"
+#include "dem/bonds/spring_bond.hpp"
 #include "support/dem_fixtures.hpp"
 
 namespace arlequin::dem {

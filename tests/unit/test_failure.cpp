@@ -11,8 +11,8 @@
 #include <memory>
 #include <random>
 
-#include "dem/penalty_contact.hpp"
-#include "dem/spring_bond.hpp"
+#include "dem/contacts/penalty_contact.hpp"
+#include "dem/bonds/spring_bond.hpp"
 #include "support/dem_fixtures.hpp"
 #include "support/omp_threads.hpp"
 

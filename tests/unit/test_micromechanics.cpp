@@ -1,4 +1,4 @@
-// Closed-form UD composite moduli against the theory row of REFERENCE.md R3 (seed Table 3).
+// Closed-form UD composite moduli against the theory row of docs/validation.md R3 (seed Table 3).
 #include <gtest/gtest.h>
 
 #include "app/micromechanics.hpp"

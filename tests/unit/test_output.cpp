@@ -67,67 +67,36 @@ TEST_F(OutputTest, CsvSeriesRoundTrip) {
   EXPECT_FALSE(fs::exists(temporary_path_for(path)));
 }
 
-TEST_F(OutputTest, JsonDumpParseRoundTrip) {
+// Our contract over nlohmann-json: summaries keep their keys in insertion order, non-finite
+// numbers become null, the file is replaced atomically, and a file that is not JSON is an
+// InputError naming it.
+TEST_F(OutputTest, JsonFilesKeepOrderWriteNullForNonFiniteAndNameABadFile) {
   Json summary = Json::object();
-  summary["name"] = "quote \" backslash \\ newline \n tab \t bell \x07 é";
   summary["steps"] = std::size_t{1000};
-  summary["big"] = std::int64_t{-9007199254740993};
+  summary["name"] = "a";
   summary["ratio"] = 0.1;
-  summary["whole"] = 3.0;
   summary["nan"] = std::nan("");
   summary["inf"] = std::numeric_limits<double>::infinity();
-  summary["ok"] = true;
-  summary["nothing"] = Json();
-  summary["nested"]["deeper"]["value"] = 42;
-  summary["list"].push_back(1);
-  summary["list"].push_back("two");
-  summary["list"].push_back(Json::array());
-  summary["list"].push_back(Json::object());
-
-  const std::string text = summary.dump();
-  EXPECT_NE(text.find(R"("name": "quote \" backslash \\ newline \n tab \t bell \u0007 é")"), std::string::npos);
-  EXPECT_NE(text.find("\"whole\": 3.0"), std::string::npos);
-  EXPECT_NE(text.find("\"nan\": null"), std::string::npos);
-  EXPECT_LT(text.find("\"name\""), text.find("\"steps\""));  // insertion order kept
-
-  const Json back = Json::parse(text);
-  EXPECT_EQ(back.at("name").as_string(), summary.at("name").as_string());
-  EXPECT_EQ(back.at("steps").type(), Json::Type::Integer);
-  EXPECT_EQ(back.at("steps").as_integer(), 1000);
-  EXPECT_EQ(back.at("big").as_integer(), -9007199254740993);
-  EXPECT_EQ(back.at("ratio").type(), Json::Type::Number);
-  EXPECT_EQ(back.at("ratio").as_number(), 0.1);
-  EXPECT_EQ(back.at("whole").type(), Json::Type::Number);
+  const fs::path path = dir_ / "summary.json";
+  write_json_atomically(path, summary);
+  const std::string text = read_text(path);
+  EXPECT_LT(text.find("\"steps\""), text.find("\"name\""));
+  EXPECT_NE(text.find("\"nan\": null"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"inf\": null"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(temporary_path_for(path)));
+  const Json back = read_json_file(path);
+  EXPECT_EQ(back.at("steps").get<std::int64_t>(), 1000);
+  EXPECT_EQ(back.at("ratio").get<double>(), 0.1);
   EXPECT_TRUE(back.at("nan").is_null());
-  EXPECT_TRUE(back.at("inf").is_null());
-  EXPECT_EQ(back.at("nested").at("deeper").at("value").as_integer(), 42);
-  EXPECT_EQ(back.at("list").as_array().size(), 4u);
-  EXPECT_EQ(back.at("list").as_array()[1].as_string(), "two");
-  EXPECT_THROW(back.at("ok").as_number(), InputError);
-  EXPECT_THROW(back.at("missing"), InputError);
 
-  // Everything but the non-finite numbers survives exactly, compact or indented.
-  summary["nan"] = Json();
-  summary["inf"] = Json();
-  EXPECT_EQ(back, summary);
-  EXPECT_EQ(Json::parse(summary.dump(-1)), summary);
-  EXPECT_EQ(summary.dump(-1).find('\n'), std::string::npos);
-
-  EXPECT_EQ(Json::parse(R"("\u00e9\ud83d\ude00\/")").as_string(), "\u00e9\U0001F600/");
-  EXPECT_EQ(Json::parse(" -1.5e3 ").as_number(), -1500.0);
-  EXPECT_EQ(Json::parse("123456789012345678901").type(), Json::Type::Number);
-  for (const char* bad : {"", "{", "[1,]", "{\"a\" 1}", "01", "tru", "\"\\x\"", "1 2", "{\"a\":1,\"a\":2}", "\"\n\""}) {
-    EXPECT_THROW(Json::parse(bad), InputError) << bad;
-  }
+  write_file_atomically(dir_ / "bad.json", "{\"a\": 1,");
   try {
-    Json::parse("[1, 2, x]");
+    read_json_file(dir_ / "bad.json");
     FAIL() << "no exception";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("offset 7"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.json: not a JSON document"), std::string::npos) << e.what();
   }
-
-  write_json_atomically(dir_ / "summary.json", summary);
-  EXPECT_EQ(Json::parse(read_text(dir_ / "summary.json")), summary);
+  EXPECT_THROW(read_json_file(dir_ / "missing.json"), InputError);
 }
 
 template <class T>

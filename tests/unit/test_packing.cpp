@@ -1,4 +1,4 @@
-// Dense random packings (seed "first challenge", DESIGN.md section 3) and sample files.
+// Dense random packings (seed "first challenge", docs/theory.md#packing) and sample files.
 #include <gtest/gtest.h>
 
 #include "support/scratch_dir.hpp"

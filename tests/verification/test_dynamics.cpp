@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "dem/penalty_contact.hpp"
+#include "dem/contacts/penalty_contact.hpp"
 #include "support/dem_fixtures.hpp"
 
 namespace arlequin::dem {

@@ -31,12 +31,16 @@
 #pragma once
 #include <array>
 
-#include "dem/bond_set.hpp"
+#include "dem/bonds/bond_kernel_set.hpp"
 
 namespace arlequin::dem {
 
-class BeamBondSet final : public BondSet {
+class BeamBondSet final : public BondKernelSet<BeamBondSet> {
  public:
+  static constexpr std::string_view name = "beam";
+  static constexpr bool torques = true;
+  static constexpr FailureCriterion criterion = FailureCriterion::bbf;
+
   struct Parameters {
     double young = 0.0;         // E_mu, Pa
     double poisson = 0.3;       // nu_mu
@@ -46,20 +50,9 @@ class BeamBondSet final : public BondSet {
   explicit BeamBondSet(const Parameters& parameters) : parameters_(parameters) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
 
-  std::string_view law() const override { return "beam"; }
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
-  void finalize(std::size_t n_particles) override;
+  // The SIMD block pass (below), recording each bond as BondKernelSet's per-bond pass does.
   void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
-  double energy(const ParticleSet& p) const override;
-  void record_energies(const ParticleSet& p) const override;
-  void add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
-                            std::span<double> rotational) const override;
-  void scale_stiffness(std::span<const double> factor) override;
-  bool has_strength() const override { return parameters_.strength > 0.0; }
-  void find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
-                     std::vector<BreakEvent>& events) const override;
-  void accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const override;
-  double bond_energy(std::size_t b, const ParticleSet& p) const override;
 
   // The generalised forces of bond b in the current configuration (for tests, sensors and
   // failure criteria): forces and torques exerted by the bond on its two DEs.
@@ -89,9 +82,25 @@ class BeamBondSet final : public BondSet {
   void actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const;
   const Parameters& parameters() const { return parameters_; }
 
- private:
-  void zero_stiffness(std::size_t b) override { axial_[b] = bending_[b] = torsion_[b] = 0.0; }
+  // The law's kernel (BondKernelSet).
+  using Evaluation = Actions;
+  Evaluation evaluate(std::size_t b, const ParticleSet& p) const { return actions(b, p); }
+  static Vec3 force_on_j(const Actions& a) { return a.force_on_j; }
+  static Vec3 torque_on_i(const Actions& a) { return a.torque_on_i; }
+  static Vec3 torque_on_j(const Actions& a) { return a.torque_on_j; }
   double energy_of(std::size_t b, const Actions& a) const;
+  double failure_measure(std::size_t b, const Actions& a) const { return axial_stress(b, a) + bending_stress(b, a); }
+  FailureMode mode_of(std::size_t b, const Actions& a) const;
+  double strength() const { return parameters_.strength; }
+  void reorder(std::span<const std::uint32_t> order);
+  void scale(std::size_t b, double factor) {
+    axial_[b] *= factor;
+    bending_[b] *= factor;
+    torsion_[b] *= factor;
+  }
+  void add_frequency_bound(std::size_t b, const ParticleSet& p, std::span<double> translational, std::span<double> rotational) const;
+
+ private:
   // BBF's normal stress terms (above), Pa: N / S, and r_b |M| / I at the more loaded end.
   double axial_stress(std::size_t b, const Actions& a) const;
   double bending_stress(std::size_t b, const Actions& a) const;
@@ -106,9 +115,8 @@ class BeamBondSet final : public BondSet {
   // a block of consecutive bonds loads each component as one vector, like the scalars above.
   std::array<std::vector<double>, 3> direction_;
   std::array<std::vector<double>, 3> normal_;
-  // BBF's sigma per bond from the last force pass with ForceScan::criterion, Pa (scratch
-  // sized by finalize, written by the force loop; one writer per bond).
-  mutable std::vector<double> failure_stress_;
 };
+
+extern template class BondKernelSet<BeamBondSet>;
 
 }  // namespace arlequin::dem

@@ -81,17 +81,11 @@ void for_each_bond(const BondColouring& colouring, Body&& body) {
 // (half), b = r_ij / 2 for both; on the radical plane (radical, the face of the Laguerre
 // cells), b_i = d_i r_ij / d with d_i = (d^2 + R_i^2 - R_j^2) / 2d, d_j = d - d_i, so that each
 // DE's virial is that of its own cell, and both add up to sym(r_ij (x) f) as before.
-inline void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
-                            std::span<Sym3> virial) {
-  const Vec3 r = p.position[j] - p.position[i];
-  double share_i = 1.0;  // 2 d_i / d
-  if (branch == VirialBranch::radical) {
-    const double d2 = norm2(r), ri = p.radius[i], rj = p.radius[j];
-    share_i = (d2 + ri * ri - rj * rj) / d2;
-  }
-  add_symmetric_product(virial[i], share_i * r, f_i);
-  add_symmetric_product(virial[j], (2.0 - share_i) * r, f_i);
-}
+// Out of line on purpose: the force pass's record and accumulate_virial() call this one compiled
+// routine, so their virials agree to the bit whatever each caller's inlining would contract
+// into fused multiply-adds.
+void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                     std::span<Sym3> virial);
 
 // What a force pass records besides forces, for the failure check of the same configuration
 // (DemModel::apply_failures) and for the energies of an output row.

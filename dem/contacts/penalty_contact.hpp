@@ -6,7 +6,7 @@
 //   stiffness  K [N/m]
 // Frictionless and central: no torque. Elastic, so a head-on impact conserves energy.
 #pragma once
-#include "dem/contact_law.hpp"
+#include "dem/contacts/contact_law.hpp"
 
 namespace arlequin::dem {
 

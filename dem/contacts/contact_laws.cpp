@@ -1,6 +1,9 @@
 // The explicit registry of contact laws: one row per law, keyed by its case-file name.
+// To add a law: (1) write dem/contacts/NAME_contact.hpp/.cpp, a ContactLaw (contact_law.hpp)
+// with a static make(section) that reads its parameters; (2) add its row below; (3) test it on
+// two DEs against its closed form.
 #include "common/registry.hpp"
-#include "dem/penalty_contact.hpp"
+#include "dem/contacts/penalty_contact.hpp"
 
 namespace arlequin::dem {
 

@@ -1,4 +1,4 @@
-#include "dem/bond_set.hpp"
+#include "dem/bonds/bond_set.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -33,6 +33,18 @@ std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> f
   std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
   threaded = long(n) > n_colours * parallel_threshold_bonds && long(n_particles) > parallel_threshold_bond_particles;
   return order;
+}
+
+void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                     std::span<Sym3> virial) {
+  const Vec3 r = p.position[j] - p.position[i];
+  double share_i = 1.0;  // 2 d_i / d
+  if (branch == VirialBranch::radical) {
+    const double d2 = norm2(r), ri = p.radius[i], rj = p.radius[j];
+    share_i = (d2 + ri * ri - rj * rj) / d2;
+  }
+  add_symmetric_product(virial[i], share_i * r, f_i);
+  add_symmetric_product(virial[j], (2.0 - share_i) * r, f_i);
 }
 
 double BondSet::recorded_energy() const {

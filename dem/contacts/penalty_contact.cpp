@@ -1,4 +1,4 @@
-#include "dem/penalty_contact.hpp"
+#include "dem/contacts/penalty_contact.hpp"
 
 #include <cmath>
 

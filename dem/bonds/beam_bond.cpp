@@ -1,4 +1,4 @@
-#include "dem/beam_bond.hpp"
+#include "dem/bonds/beam_bond.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -18,6 +18,8 @@
 #include "common/case_file.hpp"
 
 namespace arlequin::dem {
+
+template class BondKernelSet<BeamBondSet>;
 namespace {
 
 // The kinematics of BeamBondSet::block bonds at once, one bond per lane of a GCC vector (one
@@ -154,23 +156,13 @@ void BeamBondSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
   for (int k = 0; k < 3; ++k) direction_[k].push_back(direction[k]), normal_[k].push_back(normal[k]);
 }
 
-void BeamBondSet::finalize(std::size_t n_particles) {
-  const auto order = order_pairs(n_particles);
+void BeamBondSet::reorder(std::span<const std::uint32_t> order) {
   apply_order(rest_length_, order);
   apply_order(beam_radius_, order);
   apply_order(axial_, order);
   apply_order(bending_, order);
   apply_order(torsion_, order);
   for (int k = 0; k < 3; ++k) apply_order(direction_[k], order), apply_order(normal_[k], order);
-  failure_stress_.assign(size(), 0.0);
-}
-
-void BeamBondSet::scale_stiffness(std::span<const double> factor) {
-  for (std::size_t b = 0; b < size(); ++b) {
-    axial_[b] *= factor[b];
-    bending_[b] *= factor[b];
-    torsion_[b] *= factor[b];
-  }
 }
 
 BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
@@ -231,38 +223,29 @@ void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSe
 }
 
 void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
-  const auto add_actions = [&p, this](std::size_t b, const ActionsBlock& a, std::size_t l) {
-    const std::uint32_t i = first_[b], j = second_[b];
-    const Vec3 force_on_j = ActionsBlock::at(a.force_on_j, l);
-    p.force[i] -= force_on_j;
-    p.force[j] += force_on_j;
-    p.torque[i] += ActionsBlock::at(a.torque_on_i, l);
-    p.torque[j] += ActionsBlock::at(a.torque_on_j, l);
-  };
-  const bool criterion = scan.criterion && has_strength(), virial = !scan.virial.empty(), energy = scan.energy;
+  const Records r = records(scan);
   // Blocks of bonds: their actions, added, then record(b, block's actions, lane) for each bond.
   const auto each_bond = [&](auto&& record) {
     for_each_bond_block(colouring_, block, [&](std::size_t first, std::size_t last) {
       ActionsBlock actions_of;
       actions(first, last - first, p, actions_of);
       for (std::size_t b = first; b < last; ++b) {
-        add_actions(b, actions_of, b - first);
-        record(b, actions_of, b - first);
+        const std::size_t l = b - first;
+        const std::uint32_t i = first_[b], j = second_[b];
+        const Vec3 force_on_j = ActionsBlock::at(actions_of.force_on_j, l);
+        p.force[i] -= force_on_j;
+        p.force[j] += force_on_j;
+        p.torque[i] += ActionsBlock::at(actions_of.torque_on_i, l);
+        p.torque[j] += ActionsBlock::at(actions_of.torque_on_j, l);
+        record(b, actions_of, l);
       }
     });
   };
-  if (!criterion && !virial && !energy) {  // the plain pass: no test per bond (measured 8-10 % faster)
+  if (!r.any()) {  // the plain pass: no test per bond (measured 8-10 % faster)
     each_bond([](std::size_t, const ActionsBlock&, std::size_t) {});
     return;
   }
-  each_bond([&](std::size_t b, const ActionsBlock& block_actions, std::size_t l) {
-    const Actions a = block_actions[l];
-    if (criterion) failure_stress_[b] = axial_stress(b, a) + bending_stress(b, a);
-    if (energy) energy_record_[b] = energy_of(b, a);
-    // The bond pulls i with -force_on_j. A colour holds no two bonds of a DE, so the virial
-    // scatters without races, in accumulate_virial's order.
-    if (virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -a.force_on_j, scan.branch, scan.virial);
-  });
+  each_bond([&](std::size_t b, const ActionsBlock& block_actions, std::size_t l) { this->record_scan(b, block_actions[l], p, scan, r); });
 }
 
 double BeamBondSet::axial_stress(std::size_t b, const Actions& a) const {
@@ -281,63 +264,38 @@ double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
          0.5 * torsion_[b] * a.twist * a.twist;
 }
 
-double BeamBondSet::bond_energy(std::size_t b, const ParticleSet& p) const { return energy_of(b, actions(b, p)); }
-
-double BeamBondSet::energy(const ParticleSet& p) const {
-  return fixed_order_sum(static_cast<long>(size()), parallel_threshold, sum_partial_,
-                         [&](long b) { return bond_energy(static_cast<std::size_t>(b), p); });
-}
-
-void BeamBondSet::record_energies(const ParticleSet& p) const {
-  record_each([&](std::size_t b) { return bond_energy(b, p); });
-}
-
-void BeamBondSet::find_failures(const ParticleSet& p, std::uint32_t set_index, double time,
-                                std::vector<BreakEvent>& events) const {
-  if (!has_strength()) return;
-  if (failure_stress_.size() != size()) throw std::logic_error("BeamBondSet::find_failures: bonds added after finalize()");
+// The dominant stress of a failing bond: the largest of |N/S|, r_b|M|/I, the shear stress
+// V/S = 1.5 E r_b^2 |theta_a + theta_b| / L0^2 and the torsion stress G r_b |phi| / L0.
+FailureMode BeamBondSet::mode_of(std::size_t b, const Actions& a) const {
   const double E = parameters_.young, G = E / (2.0 * (1.0 + parameters_.poisson));
-  for (std::size_t b = 0; b < size(); ++b) {
-    if (broken_[b] || failure_stress_[b] < parameters_.strength) continue;
-    // A failing bond (rare): its actions again, for the mode and the energy.
-    const Actions a = actions(b, p);
-    const double L0 = rest_length_[b], rb = beam_radius_[b];
-    const double axial = axial_stress(b, a), bending = bending_stress(b, a);
-    const double sigma = failure_stress_[b];
-    const double shear = 1.5 * E * rb * rb * norm(a.theta_a + a.theta_b) / (L0 * L0);
-    const double torsion = G * rb * std::abs(a.twist) / L0;
-    FailureMode mode = axial >= 0.0 ? FailureMode::tension : FailureMode::compression;
-    double dominant = std::abs(axial);
-    for (auto [value, m] : {std::pair{bending, FailureMode::bending}, std::pair{shear, FailureMode::shear},
-                            std::pair{torsion, FailureMode::torsion}})
-      if (value > dominant) dominant = value, mode = m;
-    events.push_back({time, set_index, static_cast<std::uint32_t>(b), FailureCriterion::bbf, mode, sigma, energy_of(b, a)});
-  }
+  const double L0 = rest_length_[b], rb = beam_radius_[b];
+  const double axial = axial_stress(b, a), bending = bending_stress(b, a);
+  const double shear = 1.5 * E * rb * rb * norm(a.theta_a + a.theta_b) / (L0 * L0);
+  const double torsion = G * rb * std::abs(a.twist) / L0;
+  FailureMode mode = axial >= 0.0 ? FailureMode::tension : FailureMode::compression;
+  double dominant = std::abs(axial);
+  for (auto [value, m] : {std::pair{bending, FailureMode::bending}, std::pair{shear, FailureMode::shear},
+                          std::pair{torsion, FailureMode::torsion}})
+    if (value > dominant) dominant = value, mode = m;
+  return mode;
 }
 
-void BeamBondSet::accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const {
-  for (std::size_t b = 0; b < size(); ++b)
-    if (!broken_[b]) add_bond_virial(p, first_[b], second_[b], -actions(b, p).force_on_j, branch, virial);  // the bond pulls i with -force_on_j
-}
-
-void BeamBondSet::add_frequency_bounds(const ParticleSet& p, std::span<double> translational,
-                                       std::span<double> rotational) const {
-  for (std::size_t b = 0; b < size(); ++b) {
-    const double L0 = rest_length_[b], kb = bending_[b], kt = torsion_[b];
-    const double k_trans = std::max(axial_[b], 6.0 * kb / (L0 * L0));  // E S/L, 12 E I/L^3
-    const double k_cross = 3.0 * kb / L0;                               // 6 E I / L^2
-    const double k_rot_own = std::max(2.0 * kb, kt);                    // 4 E I / L, G J / L
-    const double k_rot_other = std::max(kb, kt);                        // 2 E I / L, G J / L
-    for (int end = 0; end < 2; ++end) {
-      const std::uint32_t i = end == 0 ? first_[b] : second_[b];
-      const std::uint32_t j = end == 0 ? second_[b] : first_[b];
-      const double mi = p.inv_mass[i], mj = p.inv_mass[j];
-      const double Ii = p.inv_inertia(i), Ij = p.inv_inertia(j);
-      translational[i] += k_trans * (mi + std::sqrt(mi * mj)) +
-                          k_cross * (std::sqrt(mi * Ii) + std::sqrt(mi * Ij));
-      rotational[i] += k_rot_own * Ii + k_rot_other * std::sqrt(Ii * Ij) +
-                       k_cross * (std::sqrt(Ii * mi) + std::sqrt(Ii * mj));
-    }
+void BeamBondSet::add_frequency_bound(std::size_t b, const ParticleSet& p, std::span<double> translational,
+                                      std::span<double> rotational) const {
+  const double L0 = rest_length_[b], kb = bending_[b], kt = torsion_[b];
+  const double k_trans = std::max(axial_[b], 6.0 * kb / (L0 * L0));  // E S/L, 12 E I/L^3
+  const double k_cross = 3.0 * kb / L0;                               // 6 E I / L^2
+  const double k_rot_own = std::max(2.0 * kb, kt);                    // 4 E I / L, G J / L
+  const double k_rot_other = std::max(kb, kt);                        // 2 E I / L, G J / L
+  for (int end = 0; end < 2; ++end) {
+    const std::uint32_t i = end == 0 ? first_[b] : second_[b];
+    const std::uint32_t j = end == 0 ? second_[b] : first_[b];
+    const double mi = p.inv_mass[i], mj = p.inv_mass[j];
+    const double Ii = p.inv_inertia(i), Ij = p.inv_inertia(j);
+    translational[i] += k_trans * (mi + std::sqrt(mi * mj)) +
+                        k_cross * (std::sqrt(mi * Ii) + std::sqrt(mi * Ij));
+    rotational[i] += k_rot_own * Ii + k_rot_other * std::sqrt(Ii * Ij) +
+                     k_cross * (std::sqrt(Ii * mi) + std::sqrt(Ii * mj));
   }
 }
 

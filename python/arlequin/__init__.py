@@ -1,0 +1,10 @@
+"""Python side of arlequin: read a run's results folder and draw its plots.
+
+`arlequin.load(path)` gives the run's tables and fields; `python3 -m arlequin.plot DIR`
+draws the plots that the C++ program describes in DIR/plots.json. Importing this package
+is cheap: numpy, pandas, h5py and matplotlib are imported only when first needed.
+"""
+
+from .results import Run, load
+
+__all__ = ["Run", "load"]
