@@ -17,6 +17,76 @@
 namespace arlequin::app {
 namespace {
 
+// ---- The schema of continuum: and coupling: (common/schema.hpp) ---------------------------
+
+constexpr KeyDoc continuum_keys[] = {
+    {"solver", KeyType::choice, "", {}, "", "finite elements or natural neighbours; swapping them is this one key", "fe | nem"},
+    {"mesh", KeyType::section, "", {}, "", "the gmsh mesh"},
+    {"material", KeyType::section, "", {}, "", "the elastic material"},
+    {"analysis", KeyType::choice, "", {}, "explicit", "explicit dynamics, or one static solve", "explicit | static"},
+    {"shape_functions", KeyType::choice, "", {}, "sibson", "nem: natural-neighbour interpolant", "sibson | laplace"},
+    {"stabilization", KeyType::number, "1", Range::positive(), "1", "nem: weight of the SCNI stabilisation term"},
+    {"petsc_options", KeyType::string, "", {}, "", "PETSc options of the static solve (e.g. -ksp_type cg -pc_type gamg)"},
+    {"boundary", KeyType::list, "", {}, "(none)", "boundary conditions on groups of mesh nodes"},
+};
+constexpr KeyDoc mesh_keys[] = {
+    {"file", KeyType::file, "", {}, "", "a gmsh .geo (meshed at load) or .msh, relative to the case"},
+    {"size", KeyType::number, "m", Range::non_negative(), "0", "element size for a .geo; 0: the file's own"},
+    {"order", KeyType::integer, "", Range::between(1, 2), "1", "element order: P1 or P2 tetrahedra"},
+};
+constexpr KeyDoc material_keys[] = {
+    {"model", KeyType::choice, "", {}, "isotropic", "elastic model", "isotropic | transversely_isotropic"},
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "", "density"},
+    {"E", KeyType::number, "Pa", Range::positive(), "", "isotropic: Young's modulus"},
+    {"nu", KeyType::number, "1", Range::open_between(-1, 0.5), "", "isotropic: Poisson's ratio"},
+    {"E_L", KeyType::number, "Pa", Range::positive(), "", "transversely isotropic: modulus along the axis"},
+    {"E_T", KeyType::number, "Pa", Range::positive(), "", "transversely isotropic: modulus across the axis"},
+    {"nu_LT", KeyType::number, "1", Range::open_between(-1, 0.5), "", "transversely isotropic: Poisson's ratio, axial load"},
+    {"nu_TT", KeyType::number, "1", Range::open_between(-1, 1), "", "transversely isotropic: Poisson's ratio in the transverse plane"},
+    {"G_LT", KeyType::number, "Pa", Range::positive(), "", "transversely isotropic: axial shear modulus"},
+    {"axis", KeyType::vec3, "1", {}, "", "transversely isotropic: the axis (normalised)"},
+};
+constexpr KeyDoc continuum_boundary_keys[] = {
+    {"group", KeyType::string, "", {}, "", "a physical group of the mesh"},
+    {"type", KeyType::choice, "", {}, "", "what it imposes", "fixed | displacement | velocity | traction"},
+    {"value", KeyType::vec3, "(m, m/s or Pa by type)", {}, "", "the imposed displacement, velocity or traction"},
+    {"components", KeyType::strings, "", {}, "(x, y, z)", "the components it acts on"},
+    {"rise", KeyType::number, "s", Range::non_negative(), "0", "velocity: time over which it rises linearly from 0"},
+    {"duration", KeyType::number, "s", Range::positive(), "inf", "velocity: time after which it stops"},
+};
+constexpr KeyDoc coupling_keys[] = {
+    {"overlap", KeyType::section, "", {}, "", "the overlap: a region (box or cylinder, with axis and dem_side) or a shell"},
+    {"weight", KeyType::choice, "", {}, "linear", "partition-of-unity weight across the overlap", "linear | cubic | constant"},
+    {"constant_value", KeyType::number, "1", Range::open_between(0, 1), "0.5", "the DEM's weight with weight: constant"},
+    {"mass_floor", KeyType::number, "1", Range::open_between(0, 1), "0.05", "least weight on a mass (keeps the critical step finite)"},
+    {"mediator", KeyType::choice, "", {}, "coarse", "multiplier space: the overlap's nodes, or one per coupled DE", "coarse | fine"},
+    {"type", KeyType::choice, "", {}, "l2", "coupling operator: velocities, or velocities and their gradients", "l2 | h1"},
+    {"length", KeyType::number, "m", Range::positive(), "", "h1: the length weighting the gradient term"},
+    {"quadrature", KeyType::choice, "", {}, "plain", "consistent: the continuum's overlap weights corrected against the DE cloud",
+     "plain | consistent"},
+    {"solver", KeyType::choice, "", {}, "petsc", "the multiplier solve: PETSc (options below) or our sparse LDL^T", "petsc | direct"},
+    {"petsc_options", KeyType::string, "", {}, "", "solver: petsc: PETSc options of the multiplier system (prefix coupling_)"},
+};
+constexpr KeyDoc overlap_keys[] = {
+    {"shell", KeyType::section, "", {}, "(none)", "the space between two boxes, the DEM inside (instead of a region)"},
+    {"axis", KeyType::choice, "", {}, "", "box: the axis across the overlap", "x | y | z"},
+    {"dem_side", KeyType::choice, "", {}, "", "which side of the overlap is the pure-DEM zone",
+     "(box: lower | upper; cylinder: base | top)"},
+};
+constexpr KeyDoc shell_keys[] = {
+    {"inner", KeyType::vec3_list, "m", {}, "", "the inner box (pure DEM inside), two corners"},
+    {"outer", KeyType::vec3_list, "m", {}, "", "the outer box (pure continuum outside), two corners"},
+};
+constexpr SchemaSection continuum_sections[] = {
+    {"continuum", "a continuum model", continuum_keys},
+    {"continuum.mesh", "its mesh", mesh_keys},
+    {"continuum.material", "its material", material_keys},
+    {"continuum.boundary[]", "a boundary condition on the continuum", continuum_boundary_keys},
+    {"coupling", "Arlequin coupling of the DEM zone and the continuum", coupling_keys},
+    {"coupling.overlap", "the overlap (also the keys of region)", overlap_keys},
+    {"coupling.overlap.shell", "a shell overlap", shell_keys},
+};
+
 using continuum::ContinuumSolver;
 
 continuum::Material read_material(CaseNode m) {
@@ -303,6 +373,8 @@ class Part final : public ContinuumPart {
 };
 
 }  // namespace
+
+std::span<const SchemaSection> ContinuumPart::schema() { return continuum_sections; }
 
 std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, std::optional<CaseNode> coupling,
                                                    const std::string& extra_petsc_options) {

@@ -3,39 +3,9 @@
 // The one adapter between the application and continuum/: its header names no continuum type,
 // so scenes without a continuum never start PETSc or read a mesh.
 //
-// Case-file section (SI units):
-//   continuum:
-//     solver: fe | nem
-//     mesh: {file: path/to/mesh.geo | .msh, size [m] (for .geo), order: 1 | 2}
-//     material: {E [Pa], nu, density [kg/m^3]}
-//             | {model: transversely_isotropic, E_L, E_T, nu_LT, nu_TT, G_LT [Pa], axis, density}
-//     shape_functions: sibson | laplace           (nem)
-//     stabilization: 1                            (nem: MSCNI's a, continuum/nem/nem_solver.hpp)
-//     petsc_options: "-ksp_type cg -pc_type gamg" (static solves; --petsc on the command line adds)
-//     analysis: explicit | static
-//     boundary:
-//       - {group, type: fixed, components: [x, y, z]}
-//       - {group, type: displacement, value [m]}            constant imposed displacement
-//       - {group, type: velocity, value [m/s], rise [s], duration [s]}  velocity ramped up over
-//         `rise` (linear), imposed until `duration`, then the displacement is held
-//       - {group, type: traction, value [Pa]}               on a surface group
-//     Displacements are imposed on top of the initial state (initial_strain), as the DEM's
-//     conditions move DEs from where they start: `fixed` holds a pre-strained face in place.
-//
-// Coupled to the DEM by the Arlequin method (coupling/) when the case has a `coupling:` section:
-//   coupling:
-//     overlap: {box: [[..], [..]], axis: x | y | z, dem_side: lower | upper}
-//            | {cylinder: {base, axis, radius, length}, dem_side: base | top}
-//            | {shell: {inner: [[..], [..]], outer: [[..], [..]]}}       (DEM inside `inner`)
-//     weight: linear | cubic | constant   (constant_value: 0.5), mass_floor: 0.05
-//     mediator: coarse | fine   (continuum nodes or particles), type: l2 | h1 (length [m])
-//     solver: petsc | direct   (the multiplier system A lambda = r: PETSc's KSP with
-//       petsc_options, default "-ksp_type preonly -pc_type cholesky", in a database of their
-//       own; or our own sparse LDL^T)
-//     quadrature: plain | consistent   (consistent: the continuum's overlap weights are
-//       corrected so that a uniform stress leaves a lattice no ghost force,
-//       coupling/coupled_model.hpp; for overlaps whose free continuum nodes lie inside the
-//       coupled body)
+// Its keys (continuum:, coupling:) are declared beside their reader in continuum_part.cpp;
+// `arlequin schema continuum` and `arlequin schema coupling` print them.
+// Coupled to the DEM by the Arlequin method (coupling/) when the case has a `coupling:` section.
 // The overlap also cuts both models to their domains: tetrahedra with every vertex in the
 // pure-DEM zone are left out of the mesh here, and the scene does not create the sample's DEs
 // beyond the overlap (in_dem_domain), so a mesh and a sample may each cover the whole body.
@@ -48,6 +18,7 @@
 #include <string>
 
 #include "common/json.hpp"
+#include "common/schema.hpp"
 #include "common/vec3.hpp"
 
 namespace arlequin {
@@ -75,6 +46,8 @@ class ContinuumPart {
   // any problem (also when this build has no continuum).
   static std::unique_ptr<ContinuumPart> read(CaseNode section, std::optional<CaseNode> coupling,
                                              const std::string& extra_petsc_options);
+  // The keys of continuum: and coupling: (none in a build without a continuum).
+  static std::span<const SchemaSection> schema();
   virtual ~ContinuumPart() = default;
 
   virtual continuum::ContinuumSolver& solver() = 0;

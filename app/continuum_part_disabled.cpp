@@ -6,6 +6,9 @@
 
 namespace arlequin::app {
 
+// Without a continuum no case reads these sections: none to declare.
+std::span<const SchemaSection> ContinuumPart::schema() { return {}; }
+
 std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, std::optional<CaseNode>, const std::string&) {
   section.fail("solver", "this build has no continuum solvers (configure with -DARLEQUIN_WITH_CONTINUUM=ON)");
 }

@@ -13,6 +13,7 @@
 
 #include "app/compare.hpp"
 #include "app/calibrate.hpp"
+#include "app/case_schema.hpp"
 #include "app/runner.hpp"
 #include "app/scene.hpp"
 #include "app/sweep.hpp"
@@ -42,6 +43,7 @@ constexpr const char* usage_main =
     "                           and BBF / RDEF strengths to its tensile failure stress\n"
     "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
     "  laws                     list the bond and contact laws (dem.material.bond.law, dem.contact.law)\n"
+    "  schema [SECTION]         the case-file keys: type, unit, range, default, help (all, or one section)\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -113,7 +115,7 @@ struct Arguments {
 Arguments parse(int argc, char** argv) {
   Arguments a;
   std::vector<std::string> args(argv + 1, argv + argc);
-  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare", "virtual-test", "calibrate", "laws"};
+  static constexpr std::string_view commands[] = {"run", "check", "sweep", "build-sample", "compare", "virtual-test", "calibrate", "laws", "schema"};
   if (args.empty()) throw InputError("no command given\n" + std::string(usage_main));
   a.command = args[0];
   if (a.command == "--help" || a.command == "-h") return a.help = true, a;
@@ -121,7 +123,7 @@ Arguments parse(int argc, char** argv) {
   if (std::find(std::begin(commands), std::end(commands), a.command) == std::end(commands)) {
     const auto guess = closest_match(a.command, commands);
     throw InputError("unknown command '" + a.command + "'" +
-                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare, virtual-test, calibrate, laws"));
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; commands: run, check, sweep, build-sample, compare, virtual-test, calibrate, laws, schema"));
   }
   for (std::size_t k = 1; k < args.size(); ++k) {
     const std::string& arg = args[k];
@@ -159,7 +161,7 @@ Arguments parse(int argc, char** argv) {
     }
   }
   if (a.command == "laws" && !a.case_file.empty()) throw InputError("arlequin laws: takes no case file");
-  if (!a.help && a.command != "laws" && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
+  if (!a.help && a.command != "laws" && a.command != "schema" && a.case_file.empty()) throw InputError("arlequin " + a.command + ": no case file given");
   if (!a.help && a.command == "compare" && a.second_case.empty())
     throw InputError("arlequin compare: give two case files (the reference first)");
   if (!a.help && a.command == "sweep" && a.axes.empty()) throw InputError("arlequin sweep: give at least one --over key=v1,v2");
@@ -172,6 +174,20 @@ int list_laws() {
   for (const auto& law : dem::bond_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
   std::printf("contact laws (dem.contact.law):\n");
   for (const auto& law : dem::contact_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  return 0;
+}
+
+// The case-file schema, or the sections under one path ("dem", "coupling.overlap", "bond").
+int print_schema(const std::string& section) {
+  const std::string text = app::case_schema().describe(section);
+  if (text.empty()) {
+    std::vector<std::string_view> paths;
+    for (const auto& s : app::case_schema().sections()) paths.push_back(s.path);
+    const auto guess = closest_match(section, paths);
+    throw InputError("arlequin schema: no section '" + section + "'" +
+                     (guess ? "; did you mean '" + std::string(*guess) + "'?" : ""));
+  }
+  std::fputs(text.c_str(), stdout);
   return 0;
 }
 
@@ -333,6 +349,7 @@ int main(int argc, char** argv) {
     if (a.command == "calibrate") return calibrate(a);
     if (a.command == "compare") return compare(a);
     if (a.command == "laws") return list_laws();
+    if (a.command == "schema") return print_schema(a.case_file);
     return check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());

@@ -12,9 +12,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/case_schema.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/region.hpp"
+#include "common/schema.hpp"
 #include "dem/sample_file.hpp"
 #include "dem/samples.hpp"
 
@@ -25,6 +27,201 @@ using dem::BoundaryCondition;
 using dem::BoundaryKind;
 
 constexpr std::string_view component_names[] = {"x", "y", "z", "all"};
+
+// ---- The schema of the sections read here (common/schema.hpp) ---------------------------
+
+constexpr KeyDoc top_keys[] = {
+    {"name", KeyType::string, "", {}, "(the case folder's name)", "the case's name, used for the default output folder"},
+    {"units", KeyType::choice, "", {}, "SI", "unit system of every number in the case", "SI"},
+    {"time", KeyType::section, "", {}, "", "the time span and step"},
+    {"dem", KeyType::section, "", {}, "(none)", "the discrete elements: sample, bonds, contact, damping, failure"},
+    {"continuum", KeyType::section, "", {}, "(none)", "a continuum model (see continuum)"},
+    {"coupling", KeyType::section, "", {}, "(none)", "Arlequin coupling of the DEM zone and the continuum (see coupling)"},
+    {"groups", KeyType::list, "", {}, "(none)", "named sets of DEs, by region or by index"},
+    {"boundary", KeyType::list, "", {}, "(none)", "DEM boundary conditions, one per group"},
+    {"initial", KeyType::list, "", {}, "(none)", "initial velocities of groups of DEs"},
+    {"initial_strain", KeyType::section, "", {}, "(none)", "a uniform initial displacement gradient of both models"},
+    {"pulse", KeyType::section, "", {}, "(none)", "an initial velocity pulse travelling along a direction"},
+    {"sensors", KeyType::list, "", {}, "(none)", "series.csv columns: forces, displacements, velocities, energies of groups"},
+    {"checks", KeyType::list, "", {}, "(none)", "acceptance checks of series columns against references"},
+    {"output", KeyType::section, "", {}, "(defaults)", "where and how often results are written"},
+};
+constexpr KeyDoc time_keys[] = {
+    {"end", KeyType::number, "s", Range::positive(), "", "simulated time at which the run ends"},
+    {"dt", KeyType::number_or_auto, "s", Range::positive(), "auto", "time step; auto: safety x the critical step, a larger one is refused"},
+    {"safety", KeyType::number, "1", Range::open_between(0, 1), "0.3", "fraction of the critical time step taken by dt: auto"},
+};
+constexpr KeyDoc dem_keys[] = {
+    {"sample", KeyType::section, "", {}, "", "how the DEs are placed (lattice, chain, particles, packing)"},
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "(none)", "DE density, with one bond law for all (else materials)"},
+    {"bond", KeyType::section, "", {}, "(none)", "bonds between every two DEs that touch, one law for all"},
+    {"materials", KeyType::names, "", {}, "(none)", "materials by name, each with its density, region and bond law"},
+    {"interface", KeyType::section, "", {}, "(none)", "the bond law between DEs of two different materials"},
+    {"bond_tolerance", KeyType::number, "1", Range::between(0, 1), "(the packing's, else 0.01)", "gap, over the mean radius, below which two DEs of materials bond"},
+    {"contact", KeyType::section, "", {}, "(none)", "contact between DEs that are not bonded (a neighbour search)"},
+    {"damping", KeyType::number, "1/s", Range::non_negative(), "0", "viscous damping of DE velocities, c in dv/dt = ... - c v"},
+    {"failure", KeyType::section, "", {}, "(none)", "failure criteria beyond the bond laws' own (RDEF)"},
+};
+constexpr KeyDoc sample_keys[] = {
+    {"build", KeyType::choice, "", {}, "", "how the DEs are made", "lattice | chain | particles | packing"},
+    {"radius", KeyType::number, "m", Range::positive(), "(none)", "DE radius (lattice, chain); a packing gives a distribution instead"},
+    {"spacing", KeyType::number, "m", Range::positive(), "(2 radius)", "centre distance of neighbours (lattice, chain)"},
+    {"origin", KeyType::vec3, "m", {}, "[0, 0, 0]", "centre of the lattice's first DE"},
+    {"counts", KeyType::numbers, "1", Range::at_least(1), "", "DEs along x, y, z (lattice)"},
+    {"start", KeyType::vec3, "m", {}, "[0, 0, 0]", "centre of the chain's first DE"},
+    {"direction", KeyType::vec3, "1", {}, "[1, 0, 0]", "direction of the chain"},
+    {"count", KeyType::integer, "", Range::at_least(1), "", "DEs in the chain"},
+    {"particles", KeyType::list, "", {}, "", "the DEs one by one (particles)"},
+    {"region", KeyType::section, "", {}, "", "the region the packing fills (a region: box, cylinder, sphere)"},
+    {"compaction", KeyType::number, "1", Range::open_between(0, 0.7), "0.63", "target solid fraction of the packing"},
+    {"min_coordination", KeyType::number, "1", Range::non_negative(), "6", "mean number of bonded neighbours the packing must reach"},
+    {"seed", KeyType::integer, "", Range::non_negative(), "1", "random seed of the packing"},
+    {"bond_tolerance", KeyType::number, "1", Range::between(0, 0.5), "0.03", "gap, over the mean radius, that counts as contact in the packing"},
+    {"file", KeyType::string, "", {}, "(results/<name>/sample.h5)", "where the packing is cached (HDF5), relative to the case"},
+};
+constexpr KeyDoc radius_distribution_keys[] = {
+    {"mean", KeyType::number, "m", Range::positive(), "", "mean DE radius"},
+    {"std", KeyType::number, "1", Range::between(0, 0.5), "0.15", "standard deviation over the mean (truncated Gaussian)"},
+    {"truncation", KeyType::number, "1", Range::positive(), "2", "radii beyond mean +- truncation x std are drawn again"},
+};
+constexpr KeyDoc particle_keys[] = {
+    {"position", KeyType::vec3, "m", {}, "", "centre of the DE"},
+    {"radius", KeyType::number, "m", Range::positive(), "", "radius of the DE"},
+    {"velocity", KeyType::vec3, "m/s", {}, "[0, 0, 0]", "initial velocity"},
+};
+constexpr KeyDoc bond_law_key{"law", KeyType::choice, "", {}, "", "the bond law (arlequin laws); its own keys follow in 'bond (law: ...)'",
+                              "beam | spring"};
+constexpr KeyDoc dem_bond_keys[] = {
+    bond_law_key,
+    {"tolerance", KeyType::number, "1", Range::between(0, 1), "(the packing's, else 0.01)", "gap, over the mean radius, below which two DEs bond"},
+};
+constexpr KeyDoc material_bond_keys[] = {bond_law_key};
+constexpr KeyDoc contact_keys[] = {
+    {"law", KeyType::choice, "", {}, "", "the contact law (arlequin laws); its own keys follow in 'contact (law: ...)'", "penalty"},
+    {"skin", KeyType::number, "m", Range::positive(), "(0.2 x the mean radius)", "neighbour list margin: rebuilt when a DE has moved half of it"},
+};
+constexpr KeyDoc materials_keys[] = {
+    {"<name>", KeyType::section, "", {}, "", "one material, under a name of the user's"},
+};
+constexpr KeyDoc material_keys[] = {
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "", "density of the material's DEs"},
+    {"region", KeyType::section, "", {}, "(everywhere else)", "where the material is; one material may go without"},
+    {"bond", KeyType::section, "", {}, "", "the bond law between two DEs of this material"},
+};
+constexpr KeyDoc interface_keys[] = {
+    {"bond", KeyType::section, "", {}, "", "the bond law between DEs of two different materials"},
+};
+constexpr KeyDoc failure_keys[] = {
+    {"rdef", KeyType::section, "", {}, "(none)", "virial-stress element failure: all bonds of a DE break (docs/theory.md#rdef)"},
+};
+constexpr KeyDoc rdef_keys[] = {
+    {"threshold", KeyType::number, "(Pa)", Range::positive(), "(none)", "equivalent stress at which a DE fails (the materials without their own)"},
+    {"material_thresholds", KeyType::section, "", {}, "(none)", "threshold per material name, Pa"},
+    {"equivalent", KeyType::choice, "", {}, "max_principal", "equivalent stress of the DE's virial", "max_principal | von_mises | hydrostatic"},
+    {"average", KeyType::choice, "", {}, "none", "average the stress over the DE's bonded neighbours of its material",
+     "none | bonded_neighbours"},
+    {"volume", KeyType::choice, "", {}, "sphere", "a DE's volume share: its sphere over compaction, or its Laguerre cell", "sphere | laguerre"},
+    {"compaction", KeyType::number, "1", Range::open_between(0, 1), "0.63", "solid fraction dividing sphere volumes (volume: sphere)"},
+};
+constexpr KeyDoc material_threshold_keys[] = {
+    {"<name>", KeyType::number, "Pa", Range::positive(), "", "RDEF threshold of that material"},
+};
+constexpr KeyDoc group_keys[] = {
+    {"name", KeyType::string, "", {}, "", "the group's name (at most 32 groups, materials included)"},
+    {"region", KeyType::section, "", {}, "(none)", "the DEs whose centre lies in this region"},
+    {"ids", KeyType::numbers, "(DE index, 0 to count - 1)", {}, "(none)", "the DEs of these indices"},
+};
+constexpr KeyDoc boundary_keys[] = {
+    {"group", KeyType::string, "", {}, "", "the group it acts on"},
+    {"type", KeyType::choice, "", {}, "", "what it imposes", "fixed | velocity | displacement | force | free"},
+    {"value", KeyType::vec3, "(m/s, m or N by type)", {}, "", "the imposed velocity, displacement or total force"},
+    {"components", KeyType::strings, "", {}, "(x, y, z)", "the components it acts on"},
+    {"rise", KeyType::number, "s", Range::non_negative(), "0", "time over which the value rises linearly from 0"},
+    {"ramp", KeyType::number, "s", Range::positive(), "(none)", "displacement: time over which it is reached"},
+    {"rotation", KeyType::choice, "", {}, "free", "whether the DEs' rotations are held", "free | fixed"},
+};
+constexpr KeyDoc initial_keys[] = {
+    {"group", KeyType::string, "", {}, "", "the group whose DEs start moving"},
+    {"velocity", KeyType::vec3, "m/s", {}, "[0, 0, 0]", "their initial velocity"},
+    {"angular_velocity", KeyType::vec3, "rad/s", {}, "[0, 0, 0]", "their initial angular velocity"},
+};
+constexpr KeyDoc initial_strain_keys[] = {
+    {"gradient", KeyType::vec3_list, "1", {}, "", "displacement gradient H by rows: u = H X on every DE and node"},
+};
+constexpr KeyDoc pulse_keys[] = {
+    {"group", KeyType::string, "", {}, "", "the DEs given the pulse's velocity"},
+    {"direction", KeyType::vec3, "1", {}, "", "direction of travel"},
+    {"center", KeyType::vec3, "m", {}, "", "the pulse's centre at t = 0"},
+    {"wavelength", KeyType::number, "m", Range::positive(), "", "its length (raised cosine) or its wavelength (tone burst)"},
+    {"amplitude", KeyType::number, "m/s", {}, "", "peak particle velocity"},
+    {"speed", KeyType::number, "m/s", Range::positive(), "", "wave speed, for the matching displacement field"},
+    {"cycles", KeyType::integer, "", Range::at_least(1), "(none)", "a Hann-windowed tone burst of this many cycles instead"},
+};
+constexpr KeyDoc sensor_keys[] = {
+    {"name", KeyType::string, "", {}, "", "column name (with _x, _y, _z per component)"},
+    {"type", KeyType::choice, "", {}, "", "what it measures", "force | displacement | velocity | energy | affine_deviation"},
+    {"on", KeyType::choice, "", {}, "(dem if the case has DEs)", "which model's group", "dem | continuum"},
+    {"group", KeyType::string, "", {}, "", "the group measured (reaction force, mean displacement or velocity, energy)"},
+    {"component", KeyType::choice, "", {}, "all", "one component, or all three", "x | y | z | all"},
+};
+constexpr KeyDoc check_keys[] = {
+    {"column", KeyType::string, "", {}, "", "the series.csv column judged"},
+    {"statistic", KeyType::choice, "", {}, "final", "what of the column is judged", "final | max | min | final_over_initial"},
+    {"crossing", KeyType::number, "column unit", {}, "(none)", "judge the time the column first reaches this value instead"},
+    {"expected", KeyType::number, "(the column's, or s)", {}, "(none)", "reference value (with tolerance)"},
+    {"tolerance", KeyType::number, "1", Range::positive(), "", "relative tolerance on expected"},
+    {"at_most", KeyType::number, "column unit", {}, "(none)", "upper bound (instead of expected)"},
+    {"at_least", KeyType::number, "column unit", {}, "(none)", "lower bound (instead of expected)"},
+    {"note", KeyType::string, "", {}, "", "where the reference comes from, shown with the result"},
+};
+constexpr KeyDoc output_keys[] = {
+    {"dir", KeyType::string, "", {}, "(results/<name>)", "output folder, relative to the working directory"},
+    {"every", KeyType::number, "s", Range::positive(), "(time.end / 100)", "interval of series.csv rows"},
+    {"fields", KeyType::strings, "", {}, "[]", "field sets written to fields.h5: particles, bonds, continuum"},
+    {"fields_every", KeyType::number, "s", Range::positive(), "(every)", "interval of fields.h5 frames"},
+    {"plots", KeyType::list, "", {}, "(none)", "plots of series columns, drawn by the Python package"},
+};
+constexpr KeyDoc plot_keys[] = {
+    {"file", KeyType::string, "", {}, "", "image name in the output folder: .png, .svg or .pdf"},
+    {"title", KeyType::string, "", {}, "", "title"},
+    {"x", KeyType::string, "", {}, "", "column on the x axis"},
+    {"x_scale", KeyType::number, "1", {}, "1", "factor on x (e.g. 1 / L for a strain)"},
+    {"x_label", KeyType::string, "", {}, "(x)", "x axis label"},
+    {"y", KeyType::strings, "", {}, "", "columns on the left axis"},
+    {"y_scale", KeyType::number, "1", {}, "1", "factor on the left axis' columns"},
+    {"y_label", KeyType::string, "", {}, "", "left axis label"},
+    {"y2", KeyType::strings, "", {}, "[]", "columns on the right axis"},
+    {"y2_scale", KeyType::number, "1", {}, "1", "factor on the right axis' columns"},
+    {"y2_label", KeyType::string, "", {}, "", "right axis label"},
+};
+
+constexpr SchemaSection scene_sections[] = {
+    {"", "a case file's top-level sections", top_keys},
+    {"time", "time span and step", time_keys},
+    {"dem", "the discrete elements", dem_keys},
+    {"dem.sample", "how the DEs are placed", sample_keys},
+    {"dem.sample.radius", "radius distribution of a packing (truncated Gaussian)", radius_distribution_keys},
+    {"dem.sample.particles[]", "one DE of build: particles", particle_keys},
+    {"dem.bond", "bonds of every touching pair, one law", dem_bond_keys},
+    {"dem.materials", "materials by name", materials_keys},
+    {"dem.materials.<name>", "one material", material_keys},
+    {"dem.materials.<name>.bond", "the material's bond law", material_bond_keys},
+    {"dem.interface", "between materials", interface_keys},
+    {"dem.interface.bond", "the bond law between materials", material_bond_keys},
+    {"dem.contact", "contact of unbonded DEs", contact_keys},
+    {"dem.failure", "failure criteria", failure_keys},
+    {"dem.failure.rdef", "RDEF (virial stress of a DE)", rdef_keys},
+    {"dem.failure.rdef.material_thresholds", "RDEF threshold per material", material_threshold_keys},
+    {"groups[]", "a named group of DEs (a region or ids)", group_keys},
+    {"boundary[]", "a DEM boundary condition", boundary_keys},
+    {"initial[]", "an initial velocity", initial_keys},
+    {"initial_strain", "a uniform initial strain", initial_strain_keys},
+    {"pulse", "an initial velocity pulse", pulse_keys},
+    {"sensors[]", "a series.csv column (or three)", sensor_keys},
+    {"checks[]", "an acceptance check judged at time.end", check_keys},
+    {"output", "results", output_keys},
+    {"output.plots[]", "a plot of series columns", plot_keys},
+};
 
 // A dense random packing (dem/packing.hpp), cached in an HDF5 sample file: built once, then
 // loaded while the file's spec matches the case's.
@@ -572,6 +769,8 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
 
 }  // namespace
 
+std::span<const SchemaSection> scene_schema() { return scene_sections; }
+
 std::vector<std::string> sensor_columns(const Scene& scene) {
   std::vector<std::string> out;
   for (const Sensor& s : scene.sensors) {
@@ -585,7 +784,7 @@ std::vector<std::string> sensor_columns(const Scene& scene) {
 }
 
 Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options) {
-  CaseFile file = CaseFile::load(case_file, options.overrides);
+  CaseFile file = CaseFile::load(case_file, options.overrides, &case_schema());
   CaseNode root = file.root();
   Scene scene;
   scene.case_file = case_file;

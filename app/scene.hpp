@@ -2,32 +2,8 @@
 // (no contact search without a contact law, no HDF5 file without field output, no PETSc
 // without a continuum).
 //
-// Case-file schema (SI units; every key checked; see cases/*/case.yaml for examples):
-//   name, units: SI
-//   time:    {end [s], dt: auto | [s], safety: 0.3}   (optional for a static continuum alone)
-//   (at least one of dem and continuum; continuum: see app/continuum_part.hpp)
-//   dem:     {sample: {build: lattice | chain | particles, ...}, density [kg/m^3],
-//             bond: {law: <bond law>, tolerance, ...law parameters},      (optional)
-//             contact: {law: <contact law>, skin [m], ...law parameters}, (optional)
-//             damping [1/s], failure: {rdef: {threshold [Pa], material_thresholds: {<material>: [Pa]},
-//                                                equivalent: max_principal | von_mises | hydrostatic,
-//                                                average: none | bonded_neighbours, compaction}}}
-//             (BBF strengths are bond-law parameters: sigma_f for beams, max_elongation for springs)
-//   groups:   [{name, region: {box | cylinder | sphere | half_space}} | {name, ids: [..]}]
-//   boundary: [{group, type: fixed | velocity | displacement | force | free, value, ramp, rise, rotation,
-//               components}]
-//   initial:  [{group, velocity [m/s], angular_velocity [rad/s]}]
-//   initial_strain: {gradient: [[..], [..], [..]]}: start from u = H x (DEM and continuum)
-//   pulse:    {group, direction, center [m], wavelength [m], amplitude [m/s], speed [m/s]}: a
-//             raised-cosine velocity pulse travelling along `direction` (DEM)
-//   sensors:  [{name, type: force | displacement | velocity | energy, group, component: x | y | z | all,
-//               on: dem | continuum (default: the model the case has; dem if both)}
-//              | {name, type: affine_deviation}]  (needs initial_strain: see Sensor)
-//   checks:   [{column, statistic: final | max | min | final_over_initial, expected, tolerance, note}
-//              | {column, statistic, at_most, at_least, note}
-//              | {column, crossing: value, expected: time [s], tolerance, note}]
-//   output:   {dir, every [s], fields: [particles, bonds, continuum], fields_every [s],
-//              plots: [{file, title, x, x_scale, x_label, y: [..], y_scale, y_label, y2: [..], y2_scale, y2_label}]}
+// The case-file keys are declared beside their readers (scene.cpp, continuum_part.cpp,
+// common/region.cpp, each law's file) and printed by `arlequin schema [section]`.
 #pragma once
 #include <array>
 #include <cmath>
@@ -38,6 +14,7 @@
 
 #include "app/continuum_part.hpp"
 #include "common/case_file.hpp"
+#include "common/schema.hpp"
 #include "dem/dem_model.hpp"
 #include "dem/sample_file.hpp"
 
@@ -121,6 +98,9 @@ struct SceneOptions {
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).
 std::vector<std::string> sensor_columns(const Scene& scene);
+
+// The schema of the sections that build_scene reads itself (app/case_schema.cpp adds the rest).
+std::span<const SchemaSection> scene_schema();
 // The columns series.csv adds for a coupled scene: the work of the multiplier forces (J) and
 // the coupling's monitor (ContinuumPart::coupling_monitor), in this order.
 inline constexpr const char* coupling_columns[] = {"W_coupling", "G_residual", "V_mismatch_rms", "V_mismatch_max"};

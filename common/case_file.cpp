@@ -1,4 +1,5 @@
 #include "common/case_file.hpp"
+#include "common/schema.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -60,6 +61,7 @@ struct CaseState {
   std::vector<YAML::Node> nodes;
   std::vector<std::pair<std::string, std::string>> overrides;  // key path -> "--set ..." text
   CaseRecord resolved;
+  const Schema* schema = nullptr;  // checks every key read, when given
 
   // "--set ..." if an override provided `path` (or a mapping above it), else "file:line".
   std::string location(std::string_view path, int line) const {
@@ -136,6 +138,13 @@ std::string describe(const YAML::Node& n) {
 std::string joined(const auto& words) {
   std::string out;
   for (const auto& w : words) (out += out.empty() ? "" : ", ") += w;
+  return out;
+}
+
+// "a | b | c": the allowed words of a choice, as the schema writes them.
+std::string choice_text(std::span<const std::string_view> allowed) {
+  std::string out;
+  for (const auto& w : allowed) (out += out.empty() ? "" : " | ") += w;
   return out;
 }
 
@@ -409,6 +418,7 @@ std::vector<CaseNode::Entry> CaseNode::elements(const Entry& list, std::string_v
 }
 
 double CaseNode::number(std::string_view key, Range range, std::string_view unit) {
+  check_schema(key, KeyType::number, &range, unit);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, number_text("a number", range, unit));
   const double v = to_number(e, range, unit, false);
@@ -417,6 +427,8 @@ double CaseNode::number(std::string_view key, Range range, std::string_view unit
 }
 
 double CaseNode::number_or(std::string_view key, double fallback, Range range, std::string_view unit) {
+  const std::string fallback_text = format_number(fallback);
+  check_schema(key, KeyType::number, &range, unit, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Plain, format_number(fallback));
@@ -426,6 +438,8 @@ double CaseNode::number_or(std::string_view key, double fallback, Range range, s
 }
 
 std::optional<double> CaseNode::number_or_auto(std::string_view key, Range range, std::string_view unit) {
+  const std::string fallback_text = "auto";
+  check_schema(key, KeyType::number_or_auto, &range, unit, &fallback_text);
   const Entry e = lookup(key);
   if (!e.present() || (e.value.IsScalar() && e.value.Scalar() == "auto")) {
     record_->put(key, Kind::Plain, "auto");
@@ -436,6 +450,7 @@ std::optional<double> CaseNode::number_or_auto(std::string_view key, Range range
 }
 
 long long CaseNode::integer(std::string_view key, Range range) {
+  check_schema(key, KeyType::integer, &range);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, number_text("an integer", range, ""));
   const auto v = static_cast<long long>(to_number(e, range, "", true));
@@ -444,6 +459,8 @@ long long CaseNode::integer(std::string_view key, Range range) {
 }
 
 long long CaseNode::integer_or(std::string_view key, long long fallback, Range range) {
+  const std::string fallback_text = std::to_string(fallback);
+  check_schema(key, KeyType::integer, &range, {}, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Plain, std::to_string(fallback));
@@ -453,6 +470,7 @@ long long CaseNode::integer_or(std::string_view key, long long fallback, Range r
 }
 
 bool CaseNode::boolean(std::string_view key) {
+  check_schema(key, KeyType::boolean);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "true or false");
   // Only true/false: YAML 1.1 also reads yes/no/on/off, a common source of surprises.
@@ -465,6 +483,8 @@ bool CaseNode::boolean(std::string_view key) {
 }
 
 bool CaseNode::boolean_or(std::string_view key, bool fallback) {
+  const std::string fallback_text = fallback ? "true" : "false";
+  check_schema(key, KeyType::boolean, nullptr, {}, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Plain, fallback ? "true" : "false");
@@ -474,6 +494,7 @@ bool CaseNode::boolean_or(std::string_view key, bool fallback) {
 }
 
 std::string CaseNode::string(std::string_view key) {
+  check_schema(key, KeyType::string);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "a string");
   std::string s = to_string(e);
@@ -482,6 +503,8 @@ std::string CaseNode::string(std::string_view key) {
 }
 
 std::string CaseNode::string_or(std::string_view key, std::string_view fallback) {
+  const std::string fallback_text(fallback);
+  check_schema(key, KeyType::string, nullptr, {}, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Text, std::string(fallback));
@@ -491,6 +514,7 @@ std::string CaseNode::string_or(std::string_view key, std::string_view fallback)
 }
 
 std::string CaseNode::choice(std::string_view key, std::span<const std::string_view> allowed) {
+  check_schema(key, KeyType::choice, nullptr, {}, nullptr, choice_text(allowed));
   const std::string expected = "one of " + joined(allowed);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
@@ -508,6 +532,8 @@ std::string CaseNode::choice(std::string_view key, std::span<const std::string_v
 
 std::string CaseNode::choice_or(std::string_view key, std::string_view fallback,
                                 std::span<const std::string_view> allowed) {
+  const std::string fallback_text(fallback);
+  check_schema(key, KeyType::choice, nullptr, {}, &fallback_text, choice_text(allowed));
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Text, std::string(fallback));
@@ -517,6 +543,7 @@ std::string CaseNode::choice_or(std::string_view key, std::string_view fallback,
 }
 
 Vec3 CaseNode::vec3(std::string_view key, Range each, std::string_view unit) {
+  check_schema(key, KeyType::vec3, &each, unit);
   const std::string expected = number_text("a list of 3 numbers", each, unit);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
@@ -529,6 +556,8 @@ Vec3 CaseNode::vec3(std::string_view key, Range each, std::string_view unit) {
 }
 
 Vec3 CaseNode::vec3_or(std::string_view key, Vec3 fallback, Range each, std::string_view unit) {
+  const std::string fallback_text = "[" + format_number(fallback.x) + ", " + format_number(fallback.y) + ", " + format_number(fallback.z) + "]";
+  check_schema(key, KeyType::vec3, &each, unit, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put_list(key, Kind::Plain,
@@ -539,6 +568,7 @@ Vec3 CaseNode::vec3_or(std::string_view key, Vec3 fallback, Range each, std::str
 }
 
 std::vector<double> CaseNode::numbers(std::string_view key, Range each, std::string_view unit) {
+  check_schema(key, KeyType::numbers, &each, unit);
   const std::string expected = number_text("a list of numbers", each, unit);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
@@ -553,6 +583,7 @@ std::vector<double> CaseNode::numbers(std::string_view key, Range each, std::str
 }
 
 std::vector<Vec3> CaseNode::vec3_list(std::string_view key, Range each, std::string_view unit) {
+  check_schema(key, KeyType::vec3_list, &each, unit);
   const std::string expected = number_text("a list of [x, y, z] triples", each, unit);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
@@ -576,6 +607,7 @@ std::vector<Vec3> CaseNode::vec3_list(std::string_view key, Range each, std::str
 }
 
 std::vector<std::string> CaseNode::strings(std::string_view key) {
+  check_schema(key, KeyType::strings);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "a list of strings");
   std::vector<std::string> out;
@@ -605,6 +637,8 @@ std::vector<Override> CaseNode::overrides_or_empty(std::string_view key) {
 }
 
 std::vector<std::string> CaseNode::strings_or(std::string_view key, const std::vector<std::string>& fallback) {
+  const std::string fallback_text = "[" + joined(fallback) + "]";
+  check_schema(key, KeyType::strings, nullptr, {}, &fallback_text);
   if (!find(key).present()) {
     lookup(key);
     record_->put_list(key, Kind::Text, fallback);
@@ -614,6 +648,7 @@ std::vector<std::string> CaseNode::strings_or(std::string_view key, const std::v
 }
 
 std::filesystem::path CaseNode::existing_file(std::string_view key) {
+  check_schema(key, KeyType::file);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "a file path");
   const std::string text = to_string(e);
@@ -629,46 +664,53 @@ std::filesystem::path CaseNode::existing_file(std::string_view key) {
 }
 
 CaseNode CaseNode::child(std::string_view key) {
+  std::string section = check_schema(key, KeyType::section);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "a mapping");
-  return open(state_, e, record_->slot(key, Kind::Map));
+  return opened(e, record_->slot(key, Kind::Map), std::move(section));
 }
 
 std::optional<CaseNode> CaseNode::child_if(std::string_view key) {
+  check_schema(key, KeyType::section);
   if (!lookup(key).present()) return std::nullopt;
   return child(key);
 }
 
-bool CaseNode::has(std::string_view key) { return lookup(key).present(); }
+bool CaseNode::has(std::string_view key) {
+  check_schema(key, KeyType::section);  // any declared type: see check_schema
+  return lookup(key).present();
+}
 
 CaseNode CaseNode::child_named(std::string_view name) {
   const Entry e = find(name);
   if (!e.present()) missing(name, "a mapping");
   if (std::find(record_->named.begin(), record_->named.end(), name) == record_->named.end())
     record_->named.emplace_back(name);
-  return open(state_, e, record_->slot(name, Kind::Map));
+  return opened(e, record_->slot(name, Kind::Map), check_schema("<name>", KeyType::section));
 }
 
-std::vector<CaseNode> CaseNode::items(const Entry& list, std::string_view key) {
+std::vector<CaseNode> CaseNode::items(const Entry& list, std::string_view key, const std::string& section) {
   const auto entries = elements(list, "a list of mappings");
   CaseRecord& out = record_->slot(key, Kind::List);
   std::vector<CaseNode> nodes;
   for (const auto& item : entries) {
     out.items.push_back(std::make_unique<CaseRecord>());
-    nodes.push_back(open(state_, item, *out.items.back()));
+    nodes.push_back(opened(item, *out.items.back(), section + "[]"));
   }
   return nodes;
 }
 
 std::vector<CaseNode> CaseNode::list(std::string_view key) {
+  const std::string section = check_schema(key, KeyType::list);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, "a list of mappings");
-  return items(e, key);
+  return items(e, key, section);
 }
 
 std::vector<CaseNode> CaseNode::list_or_empty(std::string_view key) {
+  const std::string section = check_schema(key, KeyType::list);
   const Entry e = lookup(key);
-  return items(e.present() ? e : Entry{YAML::Node(YAML::NodeType::Null), e.path, 0}, key);
+  return items(e.present() ? e : Entry{YAML::Node(YAML::NodeType::Null), e.path, 0}, key, section);
 }
 
 std::vector<std::string> CaseNode::keys() const {
@@ -680,6 +722,45 @@ std::vector<std::string> CaseNode::keys() const {
 }
 
 void CaseNode::accept_any_keys() { record_->any_keys = true; }
+
+void CaseNode::add_schema_section(std::string_view section) { sections_.emplace_back(section); }
+
+CaseNode CaseNode::opened(const Entry& e, detail::CaseRecord& record, std::string section) const {
+  CaseNode node = open(state_, e, record);
+  node.sections_ = {std::move(section)};
+  return node;
+}
+
+std::string CaseNode::check_schema(std::string_view key, KeyType type, const Range* range, std::string_view unit,
+                                   const std::string* fallback, std::string_view values) const {
+  const std::string by_place = sections_.front().empty() ? std::string(key) : sections_.front() + "." + std::string(key);
+  const Schema* schema = state_->schema;
+  if (!schema) return by_place;
+  const KeyDoc* doc = nullptr;
+  std::string_view section;
+  for (const std::string& s : sections_)
+    if ((doc = schema->find(s, key)) || (doc = schema->find(s, "<name>"))) {  // "<name>": any user-chosen key
+      section = s;
+      break;
+    }
+  const std::string where = "schema: " + (sections_.front().empty() ? std::string("(top)") : sections_.front()) + "." + std::string(key);
+  if (!doc) throw std::logic_error(where + ": read but not declared");
+  schema->note_read(section, doc->key);
+  const std::string declared_at = section.empty() ? std::string(doc->key) : std::string(section) + "." + std::string(doc->key);
+  const bool presence_test = type == KeyType::section && doc->type != KeyType::section && doc->type != KeyType::names;
+  if (presence_test) return declared_at;  // has(key): a test of presence, whatever the key's type
+  const bool mapping = doc->type == KeyType::names && type == KeyType::section;
+  const bool number_part = doc->type == KeyType::number_or_auto && type == KeyType::number;  // number_or_auto reads via number
+  if (doc->type != type && !mapping && !number_part) throw std::logic_error(where + ": read as " + std::string(name_of(type)) + ", declared " + std::string(name_of(doc->type)));
+  const bool unit_varies = doc->unit.starts_with("(");  // "(by type)": the reader states it per case
+  if (range && !unit_varies && !(doc->range == *range)) throw std::logic_error(where + ": read with range '" + range->describe() + "', declared '" + doc->range.describe() + "'");
+  if (range && !unit_varies && doc->unit != unit) throw std::logic_error(where + ": read in [" + std::string(unit) + "], declared [" + std::string(doc->unit) + "]");
+  if (!doc->values.starts_with("(") && doc->values != values) throw std::logic_error(where + ": read as one of '" + std::string(values) + "', declared '" + std::string(doc->values) + "'");
+  const bool computed = doc->fallback.starts_with("(");
+  if (fallback && !computed && doc->fallback != *fallback)
+    throw std::logic_error(where + ": read with default '" + *fallback + "', declared '" + std::string(doc->fallback) + "'");
+  return declared_at;
+}
 
 bool CaseNode::recognised(std::string_view key) const {
   const auto& known = record_->known;
@@ -703,8 +784,9 @@ void CaseNode::finish() const {
 
 // ---- CaseFile ------------------------------------------------------------------------
 
-CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<Override>& overrides) {
+CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<Override>& overrides, const Schema* schema) {
   auto state = std::make_shared<detail::CaseState>();
+  state->schema = schema;
   state->file = file;
   state->folder = std::filesystem::absolute(file).lexically_normal().parent_path();
   const std::string text = read_text(file);
@@ -721,7 +803,9 @@ CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<Ove
 }
 
 CaseNode CaseFile::root() {
-  return CaseNode::open(state_, CaseNode::Entry{state_->doc, "", 1}, state_->resolved);
+  CaseNode node = CaseNode::open(state_, CaseNode::Entry{state_->doc, "", 1}, state_->resolved);
+  node.sections_ = {""};
+  return node;
 }
 
 std::string CaseFile::resolved_yaml() const {

@@ -22,18 +22,22 @@
 
 namespace arlequin {
 
+class Schema;
+enum class KeyType;
+
 // Allowed values of a number, with a text for messages ("> 0", "in [0, 1]").
 struct Range {
   static constexpr double inf = std::numeric_limits<double>::infinity();
   double lo = -inf, hi = inf;
   bool lo_open = false, hi_open = false;
 
-  static Range any() { return {}; }
-  static Range positive() { return {0.0, inf, true, false}; }
-  static Range non_negative() { return at_least(0.0); }
-  static Range at_least(double lo) { return {lo, inf, false, false}; }
-  static Range between(double lo, double hi) { return {lo, hi, false, false}; }
-  static Range open_between(double lo, double hi) { return {lo, hi, true, true}; }
+  static constexpr Range any() { return {}; }
+  static constexpr Range positive() { return {0.0, inf, true, false}; }
+  static constexpr Range non_negative() { return at_least(0.0); }
+  static constexpr Range at_least(double lo) { return {lo, inf, false, false}; }
+  static constexpr Range between(double lo, double hi) { return {lo, hi, false, false}; }
+  static constexpr Range open_between(double lo, double hi) { return {lo, hi, true, true}; }
+  bool operator==(const Range&) const = default;
 
   bool contains(double v) const;
   std::string describe() const;  // "" for any()
@@ -114,6 +118,10 @@ class CaseNode {
   // Rejects keys present in this mapping that no accessor asked for.
   void finish() const;
 
+  // Keys of this mapping are also looked up in the schema section `section` (a registry
+  // entry's own keys, "bond (law: beam)"), as well as in the one of its place.
+  void add_schema_section(std::string_view section);
+
   // A list of "key=value" overrides, each with this key's place as its origin ("spec.yaml:14:
   // samples[1].set"); required, or empty when absent.
   std::vector<Override> overrides(std::string_view key);
@@ -135,25 +143,36 @@ class CaseNode {
   Entry find(std::string_view key) const;
   Entry lookup(std::string_view key);  // find + record the key as known
   std::vector<Entry> elements(const Entry& list, std::string_view expected) const;
-  std::vector<CaseNode> items(const Entry& list, std::string_view key);
+  std::vector<CaseNode> items(const Entry& list, std::string_view key, const std::string& section);
   double to_number(const Entry& e, Range range, std::string_view unit, bool integer) const;
   std::string to_string(const Entry& e) const;
   std::string where(const Entry& e) const;
   bool recognised(std::string_view key) const;  // asked for by an accessor so far
   [[noreturn]] void missing(std::string_view key, std::string_view expected) const;
   [[noreturn]] void mismatch(const Entry& e, std::string_view expected) const;
+  // With a schema: `key` must be declared in one of this mapping's sections as `type`, with
+  // this unit and range, these values (choice) and, for an accessor with a default, that
+  // default as text (fallback); std::logic_error otherwise. Records the key as read and returns
+  // the schema section of its value ("<declaring section>.<key>"; by place without a schema).
+  std::string check_schema(std::string_view key, KeyType type, const Range* range = nullptr, std::string_view unit = {},
+                    const std::string* fallback = nullptr, std::string_view values = {}) const;
+  CaseNode opened(const Entry& e, detail::CaseRecord& record, std::string section) const;
 
   std::shared_ptr<detail::CaseState> state_;
   std::size_t index_;  // this mapping in the state's node table
   std::string path_;
   int line_;  // 1-based line of this mapping's key (0 if unknown)
   detail::CaseRecord* record_;  // this mapping's part of the resolved document
+  // Its schema sections: where it sits ("dem.sample", "sensors[]"), then any added.
+  std::vector<std::string> sections_{std::string()};
 };
 
 // A loaded case document with its overrides applied.
 class CaseFile {
  public:
-  static CaseFile load(const std::filesystem::path& file, const std::vector<Override>& overrides = {});
+  // With a schema, every key read is checked against it (see common/schema.hpp).
+  static CaseFile load(const std::filesystem::path& file, const std::vector<Override>& overrides = {},
+                       const Schema* schema = nullptr);
 
   CaseNode root();
   // YAML of every value read so far (defaults included), in read order.

@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "common/case_file.hpp"
+#include "common/schema.hpp"
 
 namespace arlequin {
 namespace {
@@ -27,7 +28,37 @@ Vec3 unit_vector(CaseNode& node, std::string_view key) {
 
 }  // namespace
 
+constexpr KeyDoc region_keys[] = {
+    {"box", KeyType::vec3_list, "m", {}, "(one shape)", "two opposite corners [[x0, y0, z0], [x1, y1, z1]]"},
+    {"cylinder", KeyType::section, "", {}, "(one shape)", "a cylinder (base, axis, radius, length)"},
+    {"sphere", KeyType::section, "", {}, "(one shape)", "a sphere (center, radius)"},
+    {"half_space", KeyType::section, "", {}, "(one shape)", "the points on the side of a plane its normal points to (point, normal)"},
+};
+constexpr KeyDoc cylinder_keys[] = {
+    {"base", KeyType::vec3, "m", {}, "", "centre of the base disc"},
+    {"axis", KeyType::vec3, "1", {}, "", "direction from the base (normalised)"},
+    {"radius", KeyType::number, "m", Range::positive(), "", "radius"},
+    {"length", KeyType::number, "m", {}, "-1", "length along the axis; negative: unbounded"},
+};
+constexpr KeyDoc sphere_keys[] = {
+    {"center", KeyType::vec3, "m", {}, "", "centre"},
+    {"radius", KeyType::number, "m", Range::positive(), "", "radius"},
+};
+constexpr KeyDoc half_space_keys[] = {
+    {"point", KeyType::vec3, "m", {}, "", "a point of the plane"},
+    {"normal", KeyType::vec3, "1", {}, "", "the plane's normal, pointing into the region (normalised)"},
+};
+constexpr SchemaSection region_sections[] = {
+    {"region", "a region: exactly one of its shapes", region_keys},
+    {"region.cylinder", "a cylinder", cylinder_keys},
+    {"region.sphere", "a sphere", sphere_keys},
+    {"region.half_space", "a half space", half_space_keys},
+};
+
+std::span<const SchemaSection> Region::schema() { return region_sections; }
+
 Region Region::read(CaseNode& node) {
+  node.add_schema_section("region");  // the shapes' keys, wherever a region is read
   static constexpr std::string_view shapes[] = {"box", "cylinder", "sphere", "half_space"};
   int found = 0;
   for (auto s : shapes) found += node.has(s) ? 1 : 0;

@@ -1,17 +1,15 @@
 // Regions of space used to name groups of DEs, material zones and overlap zones.
 //
-// Case-file forms (one key per region):
-//   {box: [[x0,y0,z0],[x1,y1,z1]]}                      axis-aligned, bounds inclusive
-//   {cylinder: {base: [..], axis: [..], radius: r}}      infinite if no length, else base..base+length*axis
-//   {cylinder: {base: [..], axis: [..], radius: r, length: h}}
-//   {sphere: {center: [..], radius: r}}
-//   {half_space: {point: [..], normal: [..]}}            points with (x - point).normal >= 0
+// A region mapping has one key naming its shape (box, cylinder, sphere, half_space: the schema
+// section "region", `arlequin schema region`).
 // A small relative tolerance (1e-9 of the region's size) makes boundaries inclusive despite
 // round-off, so a lattice layer lying exactly on a face is inside.
 #pragma once
+#include <span>
 #include <string>
 #include <variant>
 
+#include "common/schema.hpp"
 #include "common/vec3.hpp"
 
 namespace arlequin {
@@ -42,8 +40,10 @@ class Region {
  public:
   using Shape = std::variant<Box, Cylinder, Sphere, HalfSpace>;
   explicit Region(Shape shape) : shape_(shape) {}
-  // Reads one region mapping; errors name the key and what was expected.
+  // Reads one region mapping; errors name the key and what was expected. Its keys are those
+  // of the schema section "region" (schema()), wherever the mapping sits.
   static Region read(CaseNode& node);
+  static std::span<const SchemaSection> schema();
 
   bool contains(const Vec3& x) const;
   const Shape& shape() const { return shape_; }

@@ -125,6 +125,14 @@ inline Vec3 perpendicular_to(const Vec3& d) {
 
 }  // namespace
 
+constexpr KeyDoc beam_keys[] = {
+    {"E_mu", KeyType::number, "Pa", Range::positive(), "", "the beam's Young's modulus (calibrated: arlequin calibrate)"},
+    {"nu_mu", KeyType::number, "1", Range::open_between(-1, 0.5), "0.3", "the beam's Poisson's ratio (its shear modulus)"},
+    {"r_mu", KeyType::number, "1", Range::open_between(0, 2), "", "beam radius over the two DEs' mean radius"},
+    {"sigma_f", KeyType::number, "Pa", Range::non_negative(), "0", "BBF strength: the bond breaks at this normal stress; 0: never"},
+};
+std::span<const KeyDoc> BeamBondSet::keys() { return beam_keys; }
+
 std::unique_ptr<BondSet> BeamBondSet::make(CaseNode& section) {
   Parameters prm;
   prm.young = section.number("E_mu", Range::positive(), "Pa");

@@ -49,6 +49,7 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   };
   explicit BeamBondSet(const Parameters& parameters) : parameters_(parameters) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
+  static std::span<const KeyDoc> keys();  // what make() reads
 
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
   // The SIMD block pass (below), recording each bond as BondKernelSet's per-bond pass does.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/parallel.hpp"
+#include "common/schema.hpp"
 #include "dem/failure.hpp"
 #include "dem/particles.hpp"
 
@@ -187,10 +188,12 @@ class BondSet {
 };
 
 // Registry of bond laws, keyed by the case-file name (dem.material.bond.law).
+// A law's own keys are declared by keys() beside its make() (schema section "bond (law: name)").
 struct BondLawEntry {
   std::string_view name;
   std::string_view summary;
   std::unique_ptr<BondSet> (*make)(CaseNode& parameters);
+  std::span<const KeyDoc> (*keys)();
 };
 std::span<const BondLawEntry> bond_laws();
 std::unique_ptr<BondSet> make_bond_set(CaseNode& bond_section);

@@ -8,6 +8,12 @@ namespace arlequin::dem {
 
 template class BondKernelSet<SpringBondSet>;
 
+constexpr KeyDoc spring_keys[] = {
+    {"stiffness", KeyType::number, "N/m", Range::positive(), "", "axial stiffness K of one spring (seed Eq. 6, Eq. 8 for a yarn)"},
+    {"max_elongation", KeyType::number, "1", Range::non_negative(), "0", "elongation (L - L0) / L0 at which it breaks; 0: never"},
+};
+std::span<const KeyDoc> SpringBondSet::keys() { return spring_keys; }
+
 std::unique_ptr<BondSet> SpringBondSet::make(CaseNode& section) {
   const double stiffness = section.number("stiffness", Range::positive(), "N/m");
   return std::make_unique<SpringBondSet>(stiffness, section.number_or("max_elongation", 0.0, Range::non_negative(), "1"));

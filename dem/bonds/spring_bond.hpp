@@ -21,6 +21,7 @@ class SpringBondSet final : public BondKernelSet<SpringBondSet> {
 
   SpringBondSet(double stiffness, double max_elongation = 0.0) : nominal_stiffness_(stiffness), max_elongation_(max_elongation) {}
   static std::unique_ptr<BondSet> make(CaseNode& section);
+  static std::span<const KeyDoc> keys();  // what make() reads
 
   // d = x_j - x_i and its length L: the force -K (L - L0) d / L and the elongation L / L0 - 1
   // both follow from one evaluation.

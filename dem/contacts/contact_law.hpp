@@ -9,6 +9,7 @@
 #include <span>
 #include <string_view>
 
+#include "common/schema.hpp"
 #include "dem/neighbour_list.hpp"
 #include "dem/particles.hpp"
 
@@ -32,6 +33,7 @@ struct ContactLawEntry {
   std::string_view name;
   std::string_view summary;
   std::unique_ptr<ContactLaw> (*make)(CaseNode& parameters);
+  std::span<const KeyDoc> (*keys)();  // its own keys: schema section "contact (law: name)"
 };
 std::span<const ContactLawEntry> contact_laws();
 std::unique_ptr<ContactLaw> make_contact_law(CaseNode& contact_section);

@@ -1,7 +1,7 @@
 // The explicit registry of contact laws: one row per law, keyed by its case-file name.
 // To add a law: (1) write dem/contacts/NAME_contact.hpp/.cpp, a ContactLaw (contact_law.hpp)
-// with a static make(section) that reads its parameters; (2) add its row below; (3) test it on
-// two DEs against its closed form.
+// with a static make(section) that reads its parameters and a static keys() that declares them;
+// (2) add its row below; (3) test it on two DEs against its closed form.
 #include "common/registry.hpp"
 #include "dem/contacts/penalty_contact.hpp"
 
@@ -9,13 +9,13 @@ namespace arlequin::dem {
 
 std::span<const ContactLawEntry> contact_laws() {
   static const ContactLawEntry table[] = {
-      {"penalty", "linear penalty normal contact (seed Eq. 9): stiffness", &PenaltyContact::make},
+      {"penalty", "linear penalty normal contact (seed Eq. 9): stiffness", &PenaltyContact::make, &PenaltyContact::keys},
   };
   return table;
 }
 
 std::unique_ptr<ContactLaw> make_contact_law(CaseNode& section) {
-  return choose_entry(contact_laws(), section, "law").make(section);
+  return choose_entry(contact_laws(), section, "law", "contact").make(section);
 }
 
 }  // namespace arlequin::dem

@@ -14,6 +14,7 @@ class PenaltyContact final : public ContactLaw {
  public:
   explicit PenaltyContact(double stiffness) : stiffness_(stiffness) {}
   static std::unique_ptr<ContactLaw> make(CaseNode& section);
+  static std::span<const KeyDoc> keys();  // what make() reads
 
   std::string_view law() const override { return "penalty"; }
   void accumulate_forces(const NeighbourList& list, ParticleSet& p) const override;

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "common/error.hpp"
+#include "common/schema.hpp"
 
 namespace arlequin {
 namespace {
@@ -307,6 +308,64 @@ TEST_F(CaseFileTest, RangesAndEditDistance) {
   EXPECT_EQ(edit_distance("sampel", "sample"), 2u);
   EXPECT_EQ(edit_distance("", "abc"), 3u);
   EXPECT_EQ(edit_distance("kitten", "sitting"), 3u);
+}
+
+}  // namespace
+}  // namespace arlequin
+
+namespace arlequin {
+namespace {
+
+// With a schema, each read is checked against the declared key: an undeclared key, or one read
+// with another type, unit, range, choice list or literal default, is a logic error (a bug of the
+// program, not of the case); sections nest by the declaring key, lists get "[]", user-chosen
+// names "<name>", and a registry entry's keys come in with add_schema_section. Reads are recorded.
+TEST_F(CaseFileTest, ASchemaChecksEveryReadAgainstItsDeclaration) {
+  constexpr KeyDoc top[] = {
+      {"time", KeyType::section, "", {}, "", "times"},
+      {"items", KeyType::list, "", {}, "(none)", "a list"},
+      {"materials", KeyType::names, "", {}, "(none)", "named"},
+  };
+  constexpr KeyDoc time[] = {
+      {"end", KeyType::number, "s", Range::positive(), "", "end"},
+      {"safety", KeyType::number, "1", Range::open_between(0, 1), "0.3", "fraction"},
+      {"mode", KeyType::choice, "", {}, "a", "mode", "a | b"},
+      {"count", KeyType::integer, "", Range::at_least(1), "(computed)", "a computed default"},
+  };
+  constexpr KeyDoc item[] = {{"x", KeyType::number, "(by type)", {}, "", "unit by type"}};
+  constexpr KeyDoc named[] = {{"<name>", KeyType::section, "", {}, "", "one"}};
+  constexpr KeyDoc material[] = {{"rho", KeyType::number, "kg/m^3", Range::positive(), "", "density"}};
+  constexpr KeyDoc law[] = {{"k", KeyType::number, "N/m", Range::positive(), "", "stiffness"}};
+  const Schema schema({{"", "top", top},
+                       {"time", "", time},
+                       {"items[]", "", item},
+                       {"materials", "", named},
+                       {"materials.<name>", "", material},
+                       {"time (law: x)", "", law}});
+  const fs::path file = write("time: {end: 1, k: 2}\nitems: [{x: 1}]\nmaterials: {steel: {rho: 7800}}\n");
+  CaseNode root = CaseFile::load(file, {}, &schema).root();
+  CaseNode t = root.child("time");
+  EXPECT_EQ(t.number("end", Range::positive(), "s"), 1.0);
+  EXPECT_EQ(t.number_or("safety", 0.3, Range::open_between(0, 1), "1"), 0.3);
+  static constexpr std::string_view modes[] = {"a", "b"};
+  EXPECT_EQ(t.choice_or("mode", "a", modes), "a");
+  EXPECT_EQ(t.integer_or("count", 7, Range::at_least(1)), 7);  // "(...)": any default
+  EXPECT_THROW(t.number("end", Range::non_negative(), "s"), std::logic_error);           // another range
+  EXPECT_THROW(t.number("end", Range::positive(), "ms"), std::logic_error);              // another unit
+  EXPECT_THROW(t.number_or("safety", 0.5, Range::open_between(0, 1), "1"), std::logic_error);  // another default
+  EXPECT_THROW(t.integer("end", Range::positive()), std::logic_error);                   // another type
+  static constexpr std::string_view other_modes[] = {"a", "c"};
+  EXPECT_THROW(t.choice("mode", other_modes), std::logic_error);                         // other choices
+  EXPECT_THROW(t.number_or("stop", 1.0, Range::any(), "s"), std::logic_error);           // undeclared
+  EXPECT_THROW(t.number("k", Range::positive(), "N/m"), std::logic_error);               // not yet added
+  t.add_schema_section("time (law: x)");
+  EXPECT_EQ(t.number("k", Range::positive(), "N/m"), 2.0);
+  EXPECT_EQ(root.list("items").at(0).number("x", Range::any(), "m"), 1.0);  // "(by type)": any unit
+  CaseNode materials = root.child("materials");
+  EXPECT_EQ(materials.child_named("steel").number("rho", Range::positive(), "kg/m^3"), 7800.0);
+  for (const char* read : {"|time", "time|end", "time|safety", "time (law: x)|k", "items[]|x", "materials|<name>", "materials.<name>|rho"})
+    EXPECT_TRUE(schema.read().contains(read)) << read;
+  EXPECT_FALSE(schema.read().contains("time|stop"));
 }
 
 }  // namespace

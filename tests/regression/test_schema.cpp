@@ -1,0 +1,104 @@
+// The case-file schema (app/case_schema.cpp) against its readers: every key a reader asks for is
+// declared with the type, unit, range, choices and default it is read with (CaseNode checks
+// each read; a mismatch is a logic error, so any case or test that reads the key finds it),
+// and every declared key is read by some reader (below: the shipped cases and variants that
+// take the readers through their other branches).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "app/case_schema.hpp"
+#include "app/scene.hpp"
+#include "common/error.hpp"
+#include "support/cli.hpp"
+#include "support/scratch_dir.hpp"
+
+namespace arlequin {
+namespace {
+
+using SchemaTest = test::ScratchDirTest;
+
+const std::string cases = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/";
+
+// Builds the scene of `file` with `overrides`. Input errors are expected of some variants: a
+// reader asks for its keys before it judges them, so the keys count as read all the same.
+void read_case(const std::string& file, std::vector<Override> overrides, const std::filesystem::path& dir) {
+  app::SceneOptions options;
+  options.overrides = std::move(overrides);
+  options.out_dir = dir / "out";
+  options.check_output_dir = false;
+  try {
+    app::build_scene(file, options);
+  } catch (const InputError&) {
+  }
+}
+
+TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
+  // A small packing for the REVs (their cached samples hold 10k DEs).
+  const std::vector<Override> small_packing = {"dem.sample.radius.mean=1.2e-4", "dem.sample.file=" + (dir_ / "sample.h5").string()};
+  for (const char* c : {"bar_wave_continuum/case.yaml", "bonded_block_tension/case.yaml", "cantilever_chain/case.yaml",
+                        "cantilever_continuum/case.yaml", "demo_beam_impact/case.yaml", "lattice_bar_failure/case.yaml",
+                        "patch_coupled/case.yaml", "patch_coupled/free_surface.yaml", "wave_bar_coupled/case.yaml",
+                        "wave_bar_coupled/above_cutoff.yaml", "wave_bar_dem/case.yaml"})
+    read_case(cases + c, {}, dir_);
+  for (const char* c : {"rev_elastic/case.yaml", "rev_elastic/homogeneous.yaml"}) read_case(cases + c, small_packing, dir_);
+
+  // The other branches of the readers.
+  const std::string chain = cases + "cantilever_chain/case.yaml", bar = cases + "bar_wave_continuum/case.yaml",
+                    coupled = cases + "wave_bar_coupled/case.yaml", rev = cases + "rev_elastic/case.yaml";
+  std::vector<Override> rdef = small_packing;
+  rdef.insert(rdef.end(), {"dem.failure={rdef: {threshold: 1.0e8}}"});
+  read_case(rev, rdef, dir_);
+  rdef.back() = "dem.failure={rdef: {material_thresholds: {fibre: 5.0e9, matrix: 1.5e8}}}";
+  read_case(rev, rdef, dir_);
+  read_case(chain, {"dem.bond={law: spring, stiffness: 1.0e6, max_elongation: 0.1}", "dem.contact={law: penalty, stiffness: 1.0e6}",
+                    "initial=[{group: tip, velocity: [0, 0, 1], angular_velocity: [0, 0, 1]}]",
+                    "sensors=[{name: e, type: energy, group: tip}]"},
+            dir_);
+  read_case(chain, {"groups=[{name: a, ids: [0, 1]}, {name: b, region: {sphere: {center: [0, 0, 0], radius: 1}}}, "
+                    "{name: c, region: {half_space: {point: [0, 0, 0], normal: [1, 0, 0]}}}, "
+                    "{name: d, region: {cylinder: {base: [0, 0, 0], axis: [1, 0, 0], radius: 1, length: 1}}}]",
+                    "boundary=[{group: a, type: displacement, value: [0, 0, 1.0e-6], ramp: 0.1, rotation: fixed}]"},
+            dir_);
+  read_case(chain, {"pulse={group: tip, direction: [1, 0, 0], center: [0, 0, 0], wavelength: 1.0e-3, amplitude: 0.1, speed: 1000, cycles: 3}",
+                    "checks=[{column: tip_deflection, crossing: 1.0e-6, expected: 0.1, tolerance: 0.1}, "
+                    "{column: tip_deflection, at_most: 1, at_least: 0}]",
+                    "initial_strain={gradient: [[1.0e-3, 0, 0], [0, 0, 0], [0, 0, 0]]}"},
+            dir_);
+  read_case(bar, {"continuum.material={model: transversely_isotropic, E_L: 1.0e11, E_T: 1.0e10, nu_LT: 0.3, nu_TT: 0.4, G_LT: 5.0e9, "
+                  "axis: [1, 0, 0], density: 1500}",
+                  "continuum.boundary=[{group: xmin, type: traction, value: [1, 0, 0]}]"},
+            dir_);
+  read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
+  read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
+
+  const Schema& schema = app::case_schema();
+  std::string unread;
+  for (const SchemaSection& section : schema.sections())
+    for (const KeyDoc& key : section.keys)
+      if (!schema.read().contains(std::string(section.path) + "|" + std::string(key.key)))
+        unread += "\n  " + std::string(section.path) + ": " + std::string(key.key);
+  EXPECT_TRUE(unread.empty()) << "declared but never read:" << unread;
+}
+
+// `arlequin schema` prints every section from the one table; a section on request; an unknown
+// one is refused with a suggestion.
+TEST(Schema, TheCommandPrintsTheDeclaredSections) {
+  const auto all = test::run_arlequin("schema", "stdout");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  for (const SchemaSection& section : app::case_schema().sections())
+    EXPECT_NE(all.output.find(std::string(section.path) + ": " + std::string(section.help) + "\n"), std::string::npos) << section.path;
+  EXPECT_NE(all.output.find("bond (law: beam): "), std::string::npos);
+  EXPECT_NE(all.output.find("  E_mu                number > 0 [Pa]"), std::string::npos) << all.output;
+  const auto coupling = test::run_arlequin("schema coupling", "stdout");
+  ASSERT_EQ(coupling.exit_code, 0);
+  EXPECT_NE(coupling.output.find("coupling.overlap: "), std::string::npos);
+  EXPECT_EQ(coupling.output.find("dem: "), std::string::npos) << coupling.output;
+  const auto unknown = test::run_arlequin("schema coupl.overlap");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("no section 'coupl.overlap'; did you mean 'coupling.overlap'?"), std::string::npos) << unknown.output;
+}
+
+}  // namespace
+}  // namespace arlequin
