@@ -61,6 +61,7 @@ Run execute(Prepared& prepared, const std::filesystem::path& out) {
   run.particles = scene.dem.particles.size();
   Json counts = Json::object();
   if (scene.continuum) scene.continuum->describe(counts);
+  scene.model->describe(counts);
   run.nodes = counts.value("continuum_nodes", 0L);
   try {
     run_scene(scene, run_options);

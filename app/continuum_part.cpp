@@ -110,6 +110,34 @@ continuum::Material read_material(CaseNode m) {
   return material;
 }
 
+// Both models advanced together by the Arlequin coupling (coupling::CoupledModel), which
+// finalized the DEM; the continuum part keeps its solver, this model the coupling.
+class Coupled final : public SceneModel {
+ public:
+  Coupled(dem::DemModel& dem, const ContinuumPart& continuum, std::unique_ptr<coupling::CoupledModel> model)
+      : dem_(dem), continuum_(continuum), model_(std::move(model)) {}
+  void step(double dt) override { model_->step(dt); }
+  double critical_time_step() const override { return model_->critical_time_step(); }
+  SceneEnergies energies() const override {
+    return {dem_.energies(), continuum_.kinetic_energy(), continuum_.strain_energy(), model_->coupling_work()};
+  }
+  std::optional<CouplingMonitorValues> monitor() const override {
+    const coupling::CouplingMonitor m = model_->monitor();
+    return CouplingMonitorValues{m.constraint_residual, m.velocity_mismatch, m.max_velocity_mismatch};
+  }
+  void write_fields(FieldsWriter& fields, const OutputPlan& plan) const override {
+    continuum_.write_fields(fields);
+    write_dem_fields(dem_, fields, plan);
+  }
+  std::string summary() const override { return model_->summary(); }
+  void describe(Json& counts) const override { counts["coupled_particles"] = model_->operators().num_particles(); }
+
+ private:
+  const dem::DemModel& dem_;
+  const ContinuumPart& continuum_;
+  std::unique_ptr<coupling::CoupledModel> model_;
+};
+
 class Part final : public ContinuumPart {
  public:
   Part(CaseNode section, std::optional<CaseNode> coupling, const std::string& extra_petsc_options) {
@@ -131,10 +159,12 @@ class Part final : public ContinuumPart {
     static_ = section.choice_or("analysis", "explicit", analyses) == "static";
     petsc_options_ = settings.petsc_options;
     if (coupling) {
+      coupling_ = coupling;
       if (static_) coupling->fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
       read_coupling(*coupling);
       settings.mesh.left_out = [zone = *zone_](const Vec3& x) { return zone.in_pure_dem_zone(x); };
-      settings.mesh.left_out_name = "the pure-DEM zone of coupling.overlap (" + overlap_where_ + ": " + zone_->description() + ")";
+      settings.mesh.left_out_name =
+          "the pure-DEM zone of coupling.overlap (" + coupling_->where("overlap") + ": " + zone_->description() + ")";
     }
     try {
       solver_ = continuum::make_continuum_solver(name, settings);
@@ -147,12 +177,8 @@ class Part final : public ContinuumPart {
 
   ContinuumSolver& solver() override { return *solver_; }
   bool is_static() const override { return static_; }
-  double critical_time_step() const override {
-    if (coupled_) return coupled_->critical_time_step();
-    return static_ ? INFINITY : solver_->critical_time_step();
-  }
-  void step(double dt) override { coupled_ ? coupled_->step(dt) : solver_->step(dt); }
-  bool is_coupled() const override { return coupled_ != nullptr; }
+  double critical_time_step() const override { return static_ ? INFINITY : solver_->critical_time_step(); }
+  void step(double dt) override { solver_->step(dt); }
   void set_affine_displacement(const std::array<Vec3, 3>& H) override {
     const auto& x = solver_->nodes();
     continuum::Field u(3 * x.size());
@@ -162,26 +188,15 @@ class Part final : public ContinuumPart {
     }
     solver_->set_initial_displacement(u);
   }
-  std::string coupling_summary() const override { return coupled_ ? coupled_->summary() : ""; }
-  double coupling_work() const override { return coupled_ ? coupled_->coupling_work() : 0.0; }
-  CouplingMonitorValues coupling_monitor() const override {
-    if (!coupled_) return {};
-    const coupling::CouplingMonitor m = coupled_->monitor();
-    return {m.constraint_residual, m.velocity_mismatch, m.max_velocity_mismatch};
-  }
 
   bool in_dem_domain(const Vec3& x) const override { return !zone_ || zone_->in_dem_domain(x); }
-  void couple(dem::DemModel& dem) override {
+  std::unique_ptr<SceneModel> couple(dem::DemModel& dem) override {
     options_.held_continuum_dofs = held_dofs_;
     options_.driven_des = dem.driven_particles();
     try {
-      coupled_ = std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_);
+      return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_));
     } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses, quadrature)
-      std::string_view what = e.what();
-      if (what.starts_with("coupling: ")) what.remove_prefix(10);
-      if (what.starts_with("quadrature: ")) throw InputError(quadrature_where_ + ": coupling." + std::string(what));
-      if (what.starts_with("petsc_options: ")) throw InputError(petsc_where_ + ": coupling." + std::string(what));
-      throw InputError(overlap_where_ + ": coupling.overlap: " + std::string(what));
+      fail_at_coupling_key(e);
     }
   }
   void solve_static() override { solver_->solve_static(petsc_options_); }
@@ -243,7 +258,6 @@ class Part final : public ContinuumPart {
     counts["continuum_tetrahedra"] = solver_->mesh().num_tets();
     counts["continuum_order"] = solver_->mesh().order();
     if (solver_->mesh().tets_left_out() > 0) counts["continuum_tetrahedra_left_out"] = solver_->mesh().tets_left_out();
-    if (coupled_) counts["coupled_particles"] = coupled_->operators().num_particles();
   }
 
  private:
@@ -254,8 +268,11 @@ class Part final : public ContinuumPart {
     weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
     weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
     CaseNode overlap = section.child("overlap");
-    overlap_where_ = overlap.where();
-    zone_ = read_overlap(overlap, weighting);
+    try {
+      zone_ = read_overlap(overlap, weighting);
+    } catch (const InputError& e) {  // the zone's own checks (extents, inner and outer boxes)
+      fail_at_coupling_key(e);
+    }
     static constexpr std::string_view mediators[] = {"coarse", "fine"};
     static constexpr std::string_view types[] = {"l2", "h1"};
     options_.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
@@ -264,9 +281,7 @@ class Part final : public ContinuumPart {
       options_.coupling.length = section.number("length", Range::positive(), "m");
     static constexpr std::string_view quadratures[] = {"plain", "consistent"};
     options_.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
-    quadrature_where_ = section.where("quadrature");
     static constexpr std::string_view solvers[] = {"petsc", "direct"};
-    petsc_where_ = section.where("petsc_options");
     if (section.choice_or("solver", "petsc", solvers) == "petsc")
       options_.multiplier_petsc_options = section.string_or("petsc_options", "");
     else if (section.has("petsc_options"))
@@ -274,6 +289,13 @@ class Part final : public ContinuumPart {
     else
       options_.multiplier_petsc_options.reset();
     section.finish();
+  }
+
+  // An error of the coupling library at its key in the case: a SettingError names the key
+  // (quadrature, petsc_options, mass_floor, ...); any other is about the overlap.
+  [[noreturn]] void fail_at_coupling_key(const InputError& e) const {
+    if (const auto* setting = dynamic_cast<const SettingError*>(&e)) coupling_->fail(setting->key(), setting->message());
+    coupling_->fail("overlap", e.what());
   }
 
   static Vec3 node_vector(const continuum::Field& f, int n) { return {f[3 * n], f[3 * n + 1], f[3 * n + 2]}; }
@@ -362,11 +384,8 @@ class Part final : public ContinuumPart {
 
   std::unique_ptr<ContinuumSolver> solver_;
   std::optional<coupling::OverlapZone> zone_;  // with a coupling section
-  std::string overlap_where_;                  // "case.yaml:20", for errors about the overlap
-  std::string quadrature_where_;               // the same for coupling.quadrature
-  std::string petsc_where_;                    // and for coupling.petsc_options
+  std::optional<CaseNode> coupling_;          // the case's coupling section: where its errors are
   coupling::CoupledOptions options_;
-  std::unique_ptr<coupling::CoupledModel> coupled_;
   std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)
   std::string petsc_options_;
   bool static_ = false;

@@ -9,7 +9,7 @@
 // The overlap also cuts both models to their domains: tetrahedra with every vertex in the
 // pure-DEM zone are left out of the mesh here, and the scene does not create the sample's DEs
 // beyond the overlap (in_dem_domain), so a mesh and a sample may each cover the whole body.
-// Then step() advances both models together and the DEM is finalized by the coupling.
+// Then couple() gives the model that advances both together (the coupling finalizes the DEM).
 #pragma once
 #include <array>
 #include <filesystem>
@@ -17,6 +17,7 @@
 #include <optional>
 #include <string>
 
+#include "app/scene_model.hpp"
 #include "common/json.hpp"
 #include "common/schema.hpp"
 #include "common/vec3.hpp"
@@ -34,12 +35,6 @@ class ContinuumSolver;
 
 namespace arlequin::app {
 
-struct CouplingMonitorValues {
-  double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d|
-  double velocity_mismatch_rms = 0.0;  // over the coupled DEs of |v_p - (N v_c)(x_p)|, m/s
-  double velocity_mismatch_max = 0.0;  // m/s
-};
-
 class ContinuumPart {
  public:
   // Builds the continuum, cut by the coupling's overlap when `coupling` is given; InputError for
@@ -53,19 +48,14 @@ class ContinuumPart {
   virtual continuum::ContinuumSolver& solver() = 0;
   // Where DEs may be: the pure-DEM zone and the overlap of the coupling (everywhere if uncoupled).
   virtual bool in_dem_domain(const Vec3& x) const = 0;
-  // Couples `dem` (built, with its boundary conditions, not finalized) to this continuum with
-  // the coupling section given to `read`; the coupling finalizes it. std::invalid_argument for
+  // The model that steps `dem` (built, with its boundary conditions, not finalized) and this
+  // continuum together, coupled as the coupling section given to `read` says; it finalizes
+  // the DEM. Its errors name their key in that section. std::invalid_argument for
   // contradictory DEM boundary conditions.
-  virtual void couple(dem::DemModel& dem) = 0;
-  virtual bool is_coupled() const = 0;
-  virtual std::string coupling_summary() const = 0;  // one line per item, printed at start
-  virtual double coupling_work() const = 0;          // J, work of the multiplier forces
-  // The coupling's monitor after the last step (at t = 0: after the initial projection onto
-  // the constraint); zeros when not coupled.
-  virtual CouplingMonitorValues coupling_monitor() const = 0;
+  virtual std::unique_ptr<SceneModel> couple(dem::DemModel& dem) = 0;
   virtual bool is_static() const = 0;
-  virtual double critical_time_step() const = 0;  // of the coupled system when coupled
-  virtual void step(double dt) = 0;    // one explicit step (of both models when coupled)
+  virtual double critical_time_step() const = 0;  // of the continuum alone, s
+  virtual void step(double dt) = 0;               // one explicit step of the continuum alone
   // Sets every node's displacement to H X (rows of H given), before coupling or stepping.
   virtual void set_affine_displacement(const std::array<Vec3, 3>& H) = 0;
   virtual void solve_static() = 0;     // equilibrium at the current time

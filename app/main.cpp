@@ -212,10 +212,10 @@ void print_scene_facts(const app::Scene& scene) {
     Json counts = Json::object();
     scene.continuum->describe(counts);
     std::printf("  continuum: %s\n", counts.dump(-1).c_str());
-    // The coupling's overlap, weights, operators and the critical steps of both models.
-    std::istringstream summary(scene.continuum->coupling_summary());
-    for (std::string line; std::getline(summary, line);) std::printf("  %s\n", line.c_str());
   }
+  // A coupling's overlap, weights, operators and the critical steps of both models.
+  std::istringstream summary(scene.model->summary());
+  for (std::string line; std::getline(summary, line);) std::printf("  %s\n", line.c_str());
   std::printf("  critical time step: %.6e s\n  time step: %.6e s (%.3f of critical)\n  steps: %ld to t = %.6e s\n",
               scene.dt_critical, scene.dt, scene.dt / scene.dt_critical,
               scene.steps, scene.end_time);

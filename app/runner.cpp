@@ -26,25 +26,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-constexpr const char* energy_columns[] = {"E_kinetic",    "E_bond",     "E_contact", "W_external",
-                                          "E_dissipated", "E_fracture", "E_total",   "E_balance"};
-
-double coupling_work(const Scene& scene) {
-  return scene.continuum && scene.continuum->is_coupled() ? scene.continuum->coupling_work() : 0.0;
-}
-
-// The continuum's kinetic and strain energy, J (0 without a continuum); each is a pass over
-// the continuum, so a row takes them once.
-struct ContinuumEnergies {
-  double kinetic = 0.0, strain = 0.0;
-};
-ContinuumEnergies continuum_energies(const Scene& scene) {
-  if (!scene.continuum) return {};
-  return {scene.continuum->kinetic_energy(), scene.continuum->strain_energy()};
-}
-
-// Stored energy of the whole scene: DEM kinetic + bond + contact, continuum kinetic + strain.
-double scene_total(const dem::Energies& e, const ContinuumEnergies& c) { return e.total() + c.kinetic + c.strain; }
 
 // Writes the output files of one run; every file is replaced atomically.
 class Outputs {
@@ -53,22 +34,14 @@ class Outputs {
     std::error_code ec;
     std::filesystem::create_directories(scene.output.dir, ec);
     if (ec) throw InputError("cannot create the output folder '" + scene.output.dir.string() + "': " + ec.message());
-    std::vector<std::string> columns{"time", "step"};
-    for (auto& c : sensor_columns(scene)) columns.push_back(c);
-    for (const char* c : energy_columns) columns.push_back(c);
-    if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
-    if (scene.continuum && scene.continuum->is_coupled())
-      columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
-    if (scene.dem.failure_enabled())
-      for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
-    series_.emplace(scene.output.dir / "series.csv", columns);
+    series_.emplace(scene.output.dir / "series.csv", series_columns(scene));
     if (scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields)
       fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
     write_file_atomically(scene.output.dir / "case.resolved.yaml", scene.resolved_case);
   }
 
   // One row of series.csv; returns the sensors' values.
-  std::vector<std::pair<std::string, double>> write_row(double time, long step, const dem::Energies& e,
+  std::vector<std::pair<std::string, double>> write_row(double time, long step, const SceneEnergies& energies,
                                                        double initial_total) {
     row_.assign({time, double(step)});
     std::vector<std::pair<std::string, double>> values;
@@ -83,20 +56,18 @@ class Outputs {
         }
     }
     // With a continuum, E_total and E_balance cover both models (and the coupling's work).
-    const ContinuumEnergies c = continuum_energies(scene_);
-    const double total = scene_total(e, c);
-    const double balance = total + e.dissipated + e.fracture - e.external_work - coupling_work(scene_) - initial_total;
+    const dem::Energies& e = energies.dem;
+    const double total = energies.total();
+    const double balance = total + e.dissipated + e.fracture - e.external_work - energies.coupling_work - initial_total;
     for (double x : {e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture, total, balance})
       row_.push_back(x);
     if (scene_.continuum) {
-      row_.push_back(c.kinetic);
-      row_.push_back(c.strain);
-      if (scene_.continuum->is_coupled()) {  // coupling_columns
-        const CouplingMonitorValues m = scene_.continuum->coupling_monitor();
-        for (double x : {coupling_work(scene_), m.constraint_residual, m.velocity_mismatch_rms, m.velocity_mismatch_max})
-          row_.push_back(x);
-      }
+      row_.push_back(energies.continuum_kinetic);
+      row_.push_back(energies.continuum_strain);
     }
+    if (const auto m = scene_.model->monitor())  // coupling_columns
+      for (double x : {energies.coupling_work, m->constraint_residual, m->velocity_mismatch_rms, m->velocity_mismatch_max})
+        row_.push_back(x);
     if (scene_.dem.failure_enabled()) {
       for (const auto& set : scene_.dem.bond_sets()) {
         const auto broken = set->broken();
@@ -111,8 +82,7 @@ class Outputs {
   void write_fields(double time) {
     if (!fields_) return;
     fields_->begin_frame(time);
-    if (scene_.continuum) scene_.continuum->write_fields(*fields_);
-    if (scene_.dem.particles.size() > 0) write_particles();
+    scene_.model->write_fields(*fields_, scene_.output);
     fields_->end_frame();
   }
 
@@ -206,49 +176,15 @@ class Outputs {
     breaks_last_write_ = now;
   }
 
-  void write_particles() {
-    const dem::ParticleSet& p = scene_.dem.particles;
-    fields_->add_grid("particles", p.position, FieldsWriter::CellKind::Vertex, {});
-    scratch_vec_.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) scratch_vec_[i] = p.position[i] - p.reference[i];
-    fields_->add_point_field("particles", "displacement", scratch_vec_);
-    fields_->add_point_field("particles", "velocity", p.velocity);
-    fields_->add_point_field("particles", "angular_velocity", p.angular_velocity);
-    fields_->add_point_field("particles", "radius", p.radius);
-    scratch_int_.assign(p.groups.begin(), p.groups.end());
-    fields_->add_point_field("particles", "groups", scratch_int_);
-    if (scene_.dem.failure_enabled()) fields_->add_point_field("particles", "damage", scene_.dem.damage());
-    if (scene_.output.bond_fields && !scene_.dem.bond_sets().empty()) {
-      scratch_lines_.clear();
-      scratch_set_.clear();
-      scratch_broken_.clear();
-      for (std::size_t s = 0; s < scene_.dem.bond_sets().size(); ++s) {
-        const dem::BondSet& set = *scene_.dem.bond_sets()[s];
-        for (std::size_t b = 0; b < set.size(); ++b) {
-          scratch_lines_.push_back(set.first()[b]);
-          scratch_lines_.push_back(set.second()[b]);
-          scratch_set_.push_back(static_cast<std::int32_t>(s));
-          scratch_broken_.push_back(set.broken()[b]);
-        }
-      }
-      fields_->add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, scratch_lines_);
-      fields_->add_cell_field("bonds", "bond_set", scratch_set_);
-      fields_->add_cell_field("bonds", "broken", scratch_broken_);
-    }
-  }
-
   const Scene& scene_;
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
-  std::vector<Vec3> scratch_vec_;
-  std::vector<std::int32_t> scratch_int_, scratch_set_, scratch_broken_;
   std::string breaks_text_;           // breaks.csv as it will be written
   std::size_t breaks_formatted_ = 0;  // breaks already in breaks_text_
   std::size_t breaks_on_disk_ = 0;    // breaks in the file last written
   bool breaks_file_written_ = false;
   std::chrono::steady_clock::time_point breaks_last_write_;
-  std::vector<std::int64_t> scratch_lines_;
 };
 
 // A progress line on stderr, at most twice a second: step, simulated time, rate, ETA.
@@ -345,7 +281,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Outputs outputs(scene);
   Progress progress(options.show_progress, total_steps);
   RunResult result;
-  const double initial_total = scene_total(model.energies(), continuum_energies(scene));
+  const double initial_total = scene.model->energies().total();
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
   // the motion that boundary conditions impose. A scene at rest has round-off forces (a bond's
@@ -366,9 +302,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
   const auto write_outputs = [&] {
     const auto t0 = Clock::now();
-    result.energies = model.energies();
+    const SceneEnergies energies = scene.model->energies();
+    result.energies = energies.dem;
     if (current_time() + slack >= next_row || steps_done == total_steps) {
-      result.sensors = outputs.write_row(current_time(), steps_done, result.energies, initial_total);
+      result.sensors = outputs.write_row(current_time(), steps_done, energies, initial_total);
       next_row += scene.output.every;
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
     }
@@ -395,10 +332,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     write_outputs();
     for (long n = 1; n <= total_steps; ++n) {
       if (const int signal = take_interrupt()) throw interruption(signal);
-      const bool coupled = scene.continuum && scene.continuum->is_coupled();
       if (output_after(n)) model.record_energies_in_next_step();  // the step's force pass gives the row's bond energies
-      if (model.particles.size() > 0 && !coupled) model.step(scene.dt);
-      if (scene.continuum) scene.continuum->step(scene.dt);  // both models when coupled
+      scene.model->step(scene.dt);
       ++steps_done;
       if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
       model.check_finite();
@@ -443,6 +378,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     for (const auto& set : model.bond_sets()) bonds[set->name] = set->size();
   }
   if (scene.continuum) scene.continuum->describe(counts);
+  scene.model->describe(counts);
   if (const auto* list = model.neighbours()) {
     counts["contact_candidates"] = list->pairs().size();
     counts["neighbour_rebuilds"] = list->builds();

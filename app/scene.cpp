@@ -513,16 +513,19 @@ void read_boundary(CaseNode root, dem::DemModel& model) {
   }
 }
 
-// Finalizes the DEM, through the coupling when the case couples it to the continuum; a
-// contradiction between boundary conditions is reported at the boundary section.
-void finalize_dem(CaseNode root, Scene& scene, bool coupled) {
+// Finalizes the DEM and chooses the scene's model: coupled when the case couples the DEM to the
+// continuum (the coupling finalizes the DEM), else each with its own step. A contradiction
+// between boundary conditions is reported at the boundary section.
+void finalize_models(CaseNode root, Scene& scene, bool coupled) {
   if (coupled && scene.dem.particles.size() == 0)
     root.fail("coupling", "no DE of the sample lies in the DEM domain (the pure-DEM zone and the overlap)");
   try {
-    if (coupled)
-      scene.continuum->couple(scene.dem);
-    else
+    if (coupled) {
+      scene.model = scene.continuum->couple(scene.dem);
+    } else {
       scene.dem.finalize();
+      scene.model = uncoupled_scene_model(scene.dem, scene.continuum.get());
+    }
   } catch (const std::invalid_argument& e) {
     if (root.has("boundary")) root.fail("boundary", e.what());
     throw InputError(root.where() + ": " + e.what());
@@ -771,6 +774,17 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
 
 std::span<const SchemaSection> scene_schema() { return scene_sections; }
 
+std::vector<std::string> series_columns(const Scene& scene) {
+  std::vector<std::string> columns{"time", "step"};
+  for (auto& c : sensor_columns(scene)) columns.push_back(c);
+  columns.insert(columns.end(), std::begin(energy_columns), std::end(energy_columns));
+  if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
+  if (scene.model->monitor()) columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
+  if (scene.dem.failure_enabled())
+    for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
+  return columns;
+}
+
 std::vector<std::string> sensor_columns(const Scene& scene) {
   std::vector<std::string> out;
   for (const Sensor& s : scene.sensors) {
@@ -837,7 +851,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   read_initial_strain(root, scene);
   read_sensors(root, scene);
   if (dem_node) read_boundary(root, model);
-  finalize_dem(root, scene, coupling.has_value());
+  finalize_models(root, scene, coupling.has_value());
 
   const bool static_only = scene.static_only();
   std::optional<CaseNode> time = static_only ? root.child_if("time") : root.child("time");
@@ -847,10 +861,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   if (time) time->finish();
 
   // Coupled: the coupled system's step (the smaller of both, weighted); else each model's.
-  scene.dt_critical = model.critical_time_step();
-  if (scene.continuum)
-    scene.dt_critical = scene.continuum->is_coupled() ? scene.continuum->critical_time_step()
-                                                       : std::min(scene.dt_critical, scene.continuum->critical_time_step());
+  scene.dt_critical = scene.model->critical_time_step();
   // A zero or NaN limit (a stiffness overflowing to inf, a zero mass) would give dt = 0 and a
   // run of no steps, or NaN everywhere.
   if (!static_only && !(scene.dt_critical > 0.0)) {
@@ -889,10 +900,8 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   std::vector<std::string> columns = sensor_columns(scene);
   columns.insert(columns.end(), {"E_kinetic", "E_bond", "E_contact", "W_external", "E_dissipated", "E_fracture", "E_total"});
   read_checks(root, scene, columns);
-  // Plot columns: sensors, energies, time and the broken fractions.
-  columns.insert(columns.end(), {"time", "step", "E_balance", "C_kinetic", "C_strain"});
-  columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
-  for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
+  // Plots name columns that this run writes.
+  columns = series_columns(scene);
   for (const PlotPlan& plot : scene.output.plots) {
     std::vector<std::string> used{plot.x};
     used.insert(used.end(), plot.y.begin(), plot.y.end());

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/continuum_part.hpp"
+#include "app/scene_model.hpp"
 #include "common/case_file.hpp"
 #include "common/schema.hpp"
 #include "dem/dem_model.hpp"
@@ -71,6 +72,7 @@ struct Scene {
   std::string resolved_case;  // YAML with defaults, as read
   dem::DemModel dem;                           // empty (no DE) without a dem section
   std::unique_ptr<ContinuumPart> continuum;    // null without a continuum section
+  std::unique_ptr<SceneModel> model;           // what the run steps (declared after what it refers to)
   std::optional<dem::SampleRecord> sample;     // with build: packing: its spec and report
   std::filesystem::path sample_file;           // where the packing is cached
   std::size_t des_not_created = 0;             // sample DEs beyond a coupling's overlap
@@ -101,9 +103,15 @@ std::vector<std::string> sensor_columns(const Scene& scene);
 
 // The schema of the sections that build_scene reads itself (app/case_schema.cpp adds the rest).
 std::span<const SchemaSection> scene_schema();
+// The energy columns of series.csv (SceneEnergies; E_total and E_balance over both models).
+inline constexpr const char* energy_columns[] = {"E_kinetic",    "E_bond",     "E_contact", "W_external",
+                                                 "E_dissipated", "E_fracture", "E_total",   "E_balance"};
 // The columns series.csv adds for a coupled scene: the work of the multiplier forces (J) and
-// the coupling's monitor (ContinuumPart::coupling_monitor), in this order.
+// the coupling's monitor (SceneModel::monitor), in this order.
 inline constexpr const char* coupling_columns[] = {"W_coupling", "G_residual", "V_mismatch_rms", "V_mismatch_max"};
+// Every column of the scene's series.csv, in order: time, step, sensors, energies, the
+// continuum's energies, the coupling's, the broken fractions of each bond set.
+std::vector<std::string> series_columns(const Scene& scene);
 
 // Throws InputError with file:line: key: message for any problem in the case.
 Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& options);

@@ -181,6 +181,7 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
       columns_known = true;
       Json counts = Json::object();
       if (scene.continuum) scene.continuum->describe(counts);
+      scene.model->describe(counts);
       row.particles = scene.dem.particles.size();
       row.nodes = counts.value("continuum_nodes", 0L);
       row.status = "stopped";

@@ -3,6 +3,7 @@
 #pragma once
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace arlequin {
 
@@ -10,6 +11,20 @@ namespace arlequin {
 class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// Bad input found by a library that knows which of its settings is at fault (`key`, e.g.
+// "quadrature") but not where that setting sits in a case file: the reader that passed the
+// settings in catches it and names the place (file:line: section.key: message).
+class SettingError : public InputError {
+ public:
+  SettingError(std::string key, const std::string& message)
+      : InputError(key + ": " + message), key_(std::move(key)), message_(message) {}
+  const std::string& key() const { return key_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string key_, message_;
 };
 
 // The simulation itself went wrong (NaN, blow-up, solver failure); outputs so far are kept.

@@ -45,9 +45,9 @@ bool weight_models(dem::DemModel& dem, continuum::ContinuumSolver& continuum, co
   if (const int n = first_massless_node(); n >= 0) {
     const Vec3& x = continuum.nodes()[n];
     std::ostringstream msg;
-    msg << "coupling: continuum node " << n << " at (" << x.x << ", " << x.y << ", " << x.z
+    msg << "continuum node " << n << " at (" << x.x << ", " << x.y << ", " << x.z
         << ") has no mass even with the floor";
-    throw InputError(msg.str());
+    throw SettingError("mass_floor", msg.str());
   }
   return true;
 }
@@ -117,7 +117,7 @@ void CoupledModel::make_overlap_quadrature_consistent() {
     }
     quadrature_correction_ = continuum_.correct_weights(target, constrained);
   } catch (const std::runtime_error& e) {  // InputError, or RunError from the solve
-    throw InputError(std::string("coupling: quadrature: consistent: ") + e.what() +
+    throw SettingError("quadrature", std::string("consistent: ") + e.what() +
                      " (it needs every free continuum node the overlap reaches to lie inside the coupled body: "
                      "held boundaries, no free surface through the overlap)");
   }

@@ -68,7 +68,7 @@ double median_nearest_distance(const std::vector<Vec3>& x) {
       return nearest[nearest.size() / 2];
     }
   }
-  throw InputError("coupling: could not find neighbours of the coupled DEs");
+  throw SettingError("overlap", "could not find neighbours of the coupled DEs");
 }
 
 // H1 part: sum_k D_k^T W D_k for the least-squares gradient on the DE cloud.
@@ -142,10 +142,10 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
       x.push_back(p.reference[i]);
       op.weight.push_back(4.0 / 3.0 * std::numbers::pi * p.radius[i] * p.radius[i] * p.radius[i]);
     }
-  if (op.particles.empty()) throw InputError("coupling: no DE lies in the overlap (" + zone.description() + ")");
+  if (op.particles.empty()) throw SettingError("overlap", "no DE lies in the overlap (" + zone.description() + ")");
   if (settings.type == CouplingType::h1 && !(settings.length > 0.0))
-    throw InputError("coupling: H1 coupling needs a positive length scale");
-  if (settings.gradient_radius < 0.0) throw InputError("coupling: gradient radius must not be negative");
+    throw SettingError("length", "H1 coupling needs a positive length scale");
+  if (settings.gradient_radius < 0.0) throw SettingError("overlap", "the gradient radius must not be negative");
 
   const int np = static_cast<int>(x.size()), nn = continuum.num_nodes();
   op.N = continuum.interpolation(x);

@@ -14,9 +14,9 @@ constexpr double kRampTolerance = 1e-9;  // s within [-tol, 1 + tol] counts as i
 
 void check_weighting(const OverlapZone::Weighting& w) {
   if (!(w.mass_floor > 0.0 && w.mass_floor <= 1.0))
-    throw InputError("coupling: mass floor eps must lie in (0, 1], got " + std::to_string(w.mass_floor));
+    throw SettingError("mass_floor", "must lie in (0, 1], got " + std::to_string(w.mass_floor));
   if (w.shape == WeightShape::constant && !(w.constant_value > 0.0 && w.constant_value < 1.0))
-    throw InputError("coupling: the constant weight must lie in (0, 1), got " + std::to_string(w.constant_value));
+    throw SettingError("constant_value", "must lie in (0, 1), got " + std::to_string(w.constant_value));
 }
 
 std::string vec(const Vec3& v) {
@@ -72,9 +72,9 @@ double OverlapZone::alpha_d(const Vec3& x) const {
 }
 
 OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Weighting weighting) {
-  if (axis < 0 || axis > 2) throw InputError("coupling: overlap box axis must be 0, 1 or 2");
+  if (axis < 0 || axis > 2) throw SettingError("overlap", "the box axis must be 0, 1 or 2");
   const double lo = b.lower[axis], hi = b.upper[axis];
-  if (!(hi > lo)) throw InputError("coupling: overlap box has no extent along its ramp axis");
+  if (!(hi > lo)) throw SettingError("overlap", "the box has no extent along its ramp axis");
   RampCoordinate ramp = dem_on_lower_side ? RampCoordinate([=](const Vec3& x) { return (x[axis] - lo) / (hi - lo); })
                                           : RampCoordinate([=](const Vec3& x) { return (hi - x[axis]) / (hi - lo); });
   const Region region{b};
@@ -85,7 +85,7 @@ OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Wei
 }
 
 OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting weighting) {
-  if (!(c.length > 0.0)) throw InputError("coupling: an overlap cylinder needs a positive length");
+  if (!(c.length > 0.0)) throw SettingError("overlap", "an overlap cylinder needs a positive length");
   const Vec3 base = c.base, axis = c.axis;
   const double length = c.length;
   RampCoordinate ramp = [=](const Vec3& x) {
@@ -103,10 +103,10 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
   bool ramps = false;
   for (int k = 0; k < 3; ++k) {
     if (!(outer.lower[k] <= inner.lower[k] && inner.lower[k] < inner.upper[k] && inner.upper[k] <= outer.upper[k]))
-      throw InputError("coupling: overlap shell needs the inner box strictly inside the outer one");
+      throw SettingError("overlap", "the shell needs the inner box strictly inside the outer one");
     ramps = ramps || outer.lower[k] < inner.lower[k] || inner.upper[k] < outer.upper[k];
   }
-  if (!ramps) throw InputError("coupling: overlap shell has the same inner and outer box");
+  if (!ramps) throw SettingError("overlap", "the shell has the same inner and outer box");
   RampCoordinate ramp = [=](const Vec3& x) {
     double s = -1e300;
     for (int k = 0; k < 3; ++k) {

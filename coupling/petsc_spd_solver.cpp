@@ -59,10 +59,10 @@ PetscSpdSolver::PetscSpdSolver(const Eigen::SparseMatrix<double>& A, const std::
     PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
     const PetscErrorCode read = KSPSetFromOptions(h_->ksp);
     PetscPopErrorHandler();
-    if (read != 0) throw InputError("petsc_options: PETSc refused '" + options + "' (an unknown KSP or PC type?)");
+    if (read != 0) throw SettingError("petsc_options", "PETSc refused '" + options + "' (an unknown KSP or PC type?)");
     check(KSPSetUp(h_->ksp), "KSPSetUp");
     if (const std::string unused = scope.unused(); !unused.empty())
-      throw InputError("petsc_options: PETSc did not use '" + unused + "' (misspelt, or for a solver type not chosen)");
+      throw SettingError("petsc_options", "PETSc did not use '" + unused + "' (misspelt, or for a solver type not chosen)");
   }
   check(KSPGetPC(h_->ksp, &pc), "KSPGetPC");  // the options may have replaced it
   PCFailedReason failed;

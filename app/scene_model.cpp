@@ -1,0 +1,76 @@
+#include "app/scene_model.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "app/continuum_part.hpp"
+#include "app/scene.hpp"
+
+namespace arlequin::app {
+namespace {
+
+// The DEM and the continuum each with its own step: either one alone, or both side by side.
+class Uncoupled final : public SceneModel {
+ public:
+  Uncoupled(dem::DemModel& dem, ContinuumPart* continuum) : dem_(dem), continuum_(continuum) {}
+  void step(double dt) override {
+    if (dem_.particles.size() > 0) dem_.step(dt);
+    if (continuum_) continuum_->step(dt);
+  }
+  double critical_time_step() const override {
+    const double dem = dem_.critical_time_step();
+    return continuum_ ? std::min(dem, continuum_->critical_time_step()) : dem;
+  }
+  SceneEnergies energies() const override {
+    if (!continuum_) return {dem_.energies()};
+    return {dem_.energies(), continuum_->kinetic_energy(), continuum_->strain_energy()};
+  }
+  std::optional<CouplingMonitorValues> monitor() const override { return std::nullopt; }
+  void write_fields(FieldsWriter& fields, const OutputPlan& plan) const override {
+    if (continuum_) continuum_->write_fields(fields);
+    write_dem_fields(dem_, fields, plan);
+  }
+
+ private:
+  dem::DemModel& dem_;
+  ContinuumPart* continuum_;  // null without a continuum
+};
+
+}  // namespace
+
+std::unique_ptr<SceneModel> uncoupled_scene_model(dem::DemModel& dem, ContinuumPart* continuum) {
+  return std::make_unique<Uncoupled>(dem, continuum);
+}
+
+void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const OutputPlan& plan) {
+  const dem::ParticleSet& p = dem.particles;
+  if (p.size() == 0) return;
+  fields.add_grid("particles", p.position, FieldsWriter::CellKind::Vertex, {});
+  std::vector<Vec3> displacement(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) displacement[i] = p.position[i] - p.reference[i];
+  fields.add_point_field("particles", "displacement", displacement);
+  fields.add_point_field("particles", "velocity", p.velocity);
+  fields.add_point_field("particles", "angular_velocity", p.angular_velocity);
+  fields.add_point_field("particles", "radius", p.radius);
+  const std::vector<std::int32_t> groups(p.groups.begin(), p.groups.end());
+  fields.add_point_field("particles", "groups", groups);
+  if (dem.failure_enabled()) fields.add_point_field("particles", "damage", dem.damage());
+  if (!plan.bond_fields || dem.bond_sets().empty()) return;
+  std::vector<std::int64_t> lines;
+  std::vector<std::int32_t> set_of, broken;
+  for (std::size_t s = 0; s < dem.bond_sets().size(); ++s) {
+    const dem::BondSet& set = *dem.bond_sets()[s];
+    for (std::size_t b = 0; b < set.size(); ++b) {
+      lines.push_back(set.first()[b]);
+      lines.push_back(set.second()[b]);
+      set_of.push_back(static_cast<std::int32_t>(s));
+      broken.push_back(set.broken()[b]);
+    }
+  }
+  fields.add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, lines);
+  fields.add_cell_field("bonds", "bond_set", set_of);
+  fields.add_cell_field("bonds", "broken", broken);
+}
+
+}  // namespace arlequin::app

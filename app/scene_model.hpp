@@ -1,0 +1,54 @@
+// What a run advances: the DEM alone, the continuum alone, both side by side, or both coupled
+// by the Arlequin method, behind one interface that build_scene chooses once. The runner's loop is
+// model.step(dt); rows read energies() and monitor(), frames write_fields().
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "common/fields_writer.hpp"
+#include "common/json.hpp"
+#include "dem/dem_model.hpp"
+
+namespace arlequin::app {
+
+class ContinuumPart;
+struct OutputPlan;
+
+// The energies of a row, J: the DEM's terms (zeros without DEs), the continuum's kinetic and
+// strain energy (0 without one) and the work of the multiplier forces (0 uncoupled).
+struct SceneEnergies {
+  dem::Energies dem;
+  double continuum_kinetic = 0.0, continuum_strain = 0.0;
+  double coupling_work = 0.0;
+  double total() const { return dem.total() + continuum_kinetic + continuum_strain; }
+};
+
+// The coupling's monitor after the last step (at t = 0: after the initial projection).
+struct CouplingMonitorValues {
+  double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d|
+  double velocity_mismatch_rms = 0.0;  // over the coupled DEs of |v_p - (N v_c)(x_p)|, m/s
+  double velocity_mismatch_max = 0.0;  // m/s
+};
+
+class SceneModel {
+ public:
+  virtual ~SceneModel() = default;
+  virtual void step(double dt) = 0;               // one explicit step of everything it holds
+  virtual double critical_time_step() const = 0;  // s; of the coupled system when coupled
+  virtual SceneEnergies energies() const = 0;
+  virtual std::optional<CouplingMonitorValues> monitor() const = 0;  // nullopt: nothing coupled
+  // The frame's fields: particles (and bonds, as the plan asks) and the continuum's.
+  virtual void write_fields(FieldsWriter& fields, const OutputPlan& plan) const = 0;
+  virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)
+  virtual void describe(Json& counts) const {}       // summary.json counts of its own
+};
+
+// The DEM (its DEs, if any) and the continuum (if not null) each with its own step; the
+// coupled model comes from ContinuumPart::couple.
+std::unique_ptr<SceneModel> uncoupled_scene_model(dem::DemModel& dem, ContinuumPart* continuum);
+
+// Shared by the models that hold DEs: the particles as points, the bonds as lines (plan).
+void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const OutputPlan& plan);
+
+}  // namespace arlequin::app
