@@ -10,7 +10,6 @@
 #include <utility>
 
 #include "common/error.hpp"
-#include "dem/laguerre_cells.hpp"
 
 namespace arlequin::dem {
 
@@ -104,23 +103,7 @@ void DemModel::finalize() {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
-  if (rdef_) {
-    rdef_threshold_.assign(particles.size(), rdef_->threshold);
-    rdef_class_.assign(particles.size(), -1);
-    for (std::size_t i = 0; i < particles.size(); ++i)
-      for (std::size_t g = 0; g < rdef_->group_thresholds.size(); ++g)
-        if (particles.groups[i] & (GroupMask{1} << rdef_->group_thresholds[g].first)) {
-          rdef_threshold_[i] = rdef_->group_thresholds[g].second;
-          rdef_class_[i] = static_cast<int>(g);
-          break;
-        }
-    rdef_omega_ = rdef_->volume == RdefVolume::laguerre ? laguerre_volumes(particles.reference, particles.radius)
-                                                         : sphere_volume_shares(rdef_->compaction);
-    for (std::size_t i = 0; i < particles.size(); ++i)
-      if (!(rdef_omega_[i] > 0.0))
-        throw InputError("RDEF: DE " + std::to_string(i) + " has an empty Laguerre cell (its centre lies in its neighbours' " +
-                         "cells: spheres overlapping by more than their radii); use volume: sphere");
-  }
+  if (rdef_) rdef_->prepare(particles);
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
   compute_forces();
@@ -257,11 +240,7 @@ void DemModel::compute_forces(const ForceScan& scan) {
 ForceScan DemModel::failure_scan() {
   ForceScan scan;
   scan.criterion = true;
-  if (rdef_) {
-    rdef_stress_.assign(particles.size(), Sym3{});
-    scan.virial = rdef_stress_;
-    scan.branch = rdef_->volume == RdefVolume::laguerre ? VirialBranch::radical : VirialBranch::half;
-  }
+  if (rdef_) rdef_->scan_into(scan);
   return scan;
 }
 
@@ -277,24 +256,7 @@ void DemModel::apply_failures(bool record_energy) {
   new_breaks_.clear();
   for (std::size_t s = 0; s < bond_sets_.size(); ++s)
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
-  if (rdef_) {
-    const ParticleSet& p = particles;
-    divide_by_volumes(rdef_omega_, rdef_stress_);  // the virial of the step's force pass
-    if (rdef_->average == RdefAverage::bonded_neighbours) average_over_bonded_neighbours(rdef_stress_);
-    rdef_equivalent_.resize(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i)  // -1: the DE holds
-      rdef_equivalent_[i] = equivalent_stress_reaching(rdef_stress_[i], rdef_->equivalent, rdef_threshold_[i]);
-    for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
-      const BondSet& set = *bond_sets_[s];
-      for (std::size_t b = 0; b < set.size(); ++b) {
-        const std::uint32_t i = set.first()[b], j = set.second()[b];
-        const double stress = std::max(rdef_equivalent_[i], rdef_equivalent_[j]);
-        if (set.broken()[b] || stress < 0.0) continue;
-        new_breaks_.push_back({time_, static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(b), FailureCriterion::rdef,
-                               FailureMode::tension, stress, set.bond_energy(b, p)});
-      }
-    }
-  }
+  if (rdef_) rdef_->find_failures(particles, bond_sets_, time_, new_breaks_);
   if (new_breaks_.empty()) return;
   for (const BreakEvent& e : new_breaks_) {
     BondSet& set = *bond_sets_[e.set];
@@ -314,57 +276,12 @@ void DemModel::apply_failures(bool record_energy) {
   compute_forces(scan);
 }
 
-void DemModel::average_over_bonded_neighbours(std::vector<Sym3>& sigma) {
-  // sum Omega sigma / sum Omega over the DE and its partners with the DE's own threshold (its
-  // material): across a fibre-matrix interface the stresses differ by the stiffness ratio, and
-  // mixing them would fail the matrix at once.
-  const ParticleSet& p = particles;
-  rdef_average_.resize(p.size());
-  rdef_volume_.resize(p.size());
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    rdef_volume_[i] = rdef_omega_[i];
-    for (int c = 0; c < 6; ++c) rdef_average_[i][c] = rdef_omega_[i] * sigma[i][c];
-  }
-  for (const auto& set : bond_sets_)
-    for (std::size_t b = 0; b < set->size(); ++b) {
-      if (set->broken()[b]) continue;
-      const std::uint32_t i = set->first()[b], j = set->second()[b];
-      if (rdef_class_[i] != rdef_class_[j]) continue;
-      for (int c = 0; c < 6; ++c) {
-        rdef_average_[i][c] += rdef_omega_[j] * sigma[j][c];
-        rdef_average_[j][c] += rdef_omega_[i] * sigma[i][c];
-      }
-      rdef_volume_[i] += rdef_omega_[j];
-      rdef_volume_[j] += rdef_omega_[i];
-    }
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (int c = 0; c < 6; ++c) sigma[i][c] = rdef_average_[i][c] / rdef_volume_[i];
-}
-
-std::vector<double> DemModel::sphere_volume_shares(double compaction) const {
-  std::vector<double> omega(particles.size());
-  for (std::size_t i = 0; i < omega.size(); ++i)
-    omega[i] = 4.0 / 3.0 * std::numbers::pi * std::pow(particles.radius[i], 3) / compaction;
-  return omega;
-}
-
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {
-  std::vector<Sym3> sigma;
-  virial_stress(sphere_volume_shares(compaction), VirialBranch::half, sigma);
+  // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij) (failure.hpp, seed Eq. 1), r_ij / 2 the branch.
+  std::vector<Sym3> sigma(particles.size(), Sym3{});
+  for (const auto& set : bond_sets_) set->accumulate_virial(particles, VirialBranch::half, sigma);
+  divide_by_volumes(sphere_volume_shares(particles, compaction), sigma);
   return sigma;
-}
-
-void DemModel::virial_stress(const std::vector<double>& omega, VirialBranch branch, std::vector<Sym3>& sigma) const {
-  // sigma_i = 1/(2 Omega_i) sum_j sym(r_ij (x) f_ij) (failure.hpp, seed Eq. 1), r_ij / 2 the
-  // branch (half), or the branch to the radical plane (bond_set.hpp).
-  sigma.assign(particles.size(), Sym3{});
-  for (const auto& set : bond_sets_) set->accumulate_virial(particles, branch, sigma);
-  divide_by_volumes(omega, sigma);
-}
-
-void DemModel::divide_by_volumes(const std::vector<double>& omega, std::vector<Sym3>& virial) {
-  for (std::size_t i = 0; i < virial.size(); ++i)
-    for (double& c : virial[i]) c /= 2.0 * omega[i];
 }
 
 std::vector<double> DemModel::damage() const {

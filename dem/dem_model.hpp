@@ -19,6 +19,7 @@
 #include "dem/failure.hpp"
 #include "dem/neighbour_list.hpp"
 #include "dem/particles.hpp"
+#include "dem/rdef.hpp"
 
 namespace arlequin::dem {
 
@@ -63,24 +64,9 @@ class DemModel {
   // weighted (a coupled zone is bonded).
   void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
 
-  // RDEF (failure.hpp): every bond of a DE breaks when the equivalent stress of its virial
-  // stress reaches the DE's threshold; Omega_i = sphere volume / compaction, or the DE's
-  // Laguerre cell (`volume`, computed once at finalize in the reference configuration) with
-  // the bonds' virial taken on the cells' faces (VirialBranch::radical). A DE in one of
-  // the listed groups takes that group's threshold (the first listed that holds it), any
-  // other DE `threshold` (infinite: such DEs never fail by RDEF). With `average` =
-  // bonded_neighbours the stress judged is the volume average over the DE and the DEs of its
-  // threshold group it is still bonded to (failure.hpp), which damps the DE-to-DE scatter of a
-  // random packing.
-  struct RdefSettings {
-    double threshold = 0.0;   // Pa
-    RdefEquivalent equivalent = RdefEquivalent::max_principal;
-    double compaction = 0.63; // solid fraction of the sample, for the DE's volume share
-    std::vector<std::pair<int, double>> group_thresholds;  // (group index, Pa), e.g. per material
-    RdefAverage average = RdefAverage::none;
-    RdefVolume volume = RdefVolume::sphere;
-  };
-  void enable_rdef(const RdefSettings& settings) { rdef_ = settings; }
+  // RDEF (dem/rdef.hpp) on top of the bond laws' own criteria.
+  using RdefSettings = dem::RdefSettings;
+  void enable_rdef(const RdefSettings& settings) { rdef_.emplace(settings); }
 
   void finalize();
 
@@ -139,8 +125,7 @@ class DemModel {
   void drift(double dt);
   void update_neighbours();
   void compute_forces(const ForceScan& scan = {});
-  // The scan that records, in the step's force pass, what apply_failures() needs (zeroes the
-  // RDEF virial it accumulates into).
+  // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();
   void apply_failures(bool record_energy);  // record_energy: the forces' recomputation records too
@@ -148,13 +133,6 @@ class DemModel {
   // bonds unless the last step's force pass recorded them).
   void use_energy_record() const;
   double particle_kinetic_energy(std::size_t i) const;  // DE i's, translation and rotation, J
-  void average_over_bonded_neighbours(std::vector<Sym3>& sigma);  // RDEF averaging, in place
-  // Virial stress of every DE with the volume shares omega (m^3) and the bonds' branch vectors
-  // to `branch`, into sigma (resized).
-  void virial_stress(const std::vector<double>& omega, VirialBranch branch, std::vector<Sym3>& sigma) const;
-  // sigma_i = virial_i / (2 Omega_i) (seed Eq. 1), in place.
-  static void divide_by_volumes(const std::vector<double>& omega, std::vector<Sym3>& virial);
-  std::vector<double> sphere_volume_shares(double compaction) const;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> intact_bonded_pairs() const;
   double driven_kinetic_energy() const;
   void apply_loads_and_damping();
@@ -172,18 +150,11 @@ class DemModel {
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
   std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
-  std::optional<RdefSettings> rdef_;
-  std::vector<double> rdef_threshold_;  // Pa, per DE (finalize)
-  std::vector<int> rdef_class_;         // per DE: index of its group threshold, -1 for the default
+  std::optional<RdefCriterion> rdef_;
   bool failure_on_ = false;              // a law has a strength, or RDEF is on
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
-  std::vector<Sym3> rdef_stress_;        // scratch, RDEF: virial per DE (force pass), then stress
-  std::vector<double> rdef_equivalent_;  // scratch, RDEF: its equivalent stress, or -1 if below threshold
-  std::vector<Sym3> rdef_average_;       // scratch, RDEF: neighbourhood sum of sigma Omega
-  std::vector<double> rdef_volume_;      // scratch, RDEF: neighbourhood volume (m^3)
-  std::vector<double> rdef_omega_;       // RDEF: each DE's volume share Omega_i (m^3, finalize)
   bool energy_record_requested_ = false;  // record_energies_in_next_step()
   long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
   mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE

@@ -1,7 +1,8 @@
 // The explicit registry of contact laws: one row per law, keyed by its case-file name.
-// To add a law: (1) write dem/contacts/NAME_contact.hpp/.cpp, a ContactLaw (contact_law.hpp)
-// with a static make(section) that reads its parameters and a static keys() that declares them;
-// (2) add its row below; (3) test it on two DEs against its closed form.
+// To add a law: (1) write dem/contacts/NAME_contact.hpp/.cpp, a class deriving from
+// ContactKernelLaw<Class> with the kernel listed in contact_kernel.hpp, a static make(section)
+// that reads its parameters and a static keys() that declares them; (2) add its row below;
+// (3) test it on two DEs against its closed form.
 #include "common/registry.hpp"
 #include "dem/contacts/penalty_contact.hpp"
 
