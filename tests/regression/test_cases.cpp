@@ -13,7 +13,9 @@
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
+#ifdef ARLEQUIN_WITH_CONTINUUM
 #include "continuum/continuum_solver.hpp"
+#endif
 #include "dem/bonds/bond_set.hpp"
 #include "dem/contacts/contact_law.hpp"
 #include "support/cli.hpp"

@@ -1,0 +1,259 @@
+// What a case measures and writes: sensors, checks, output folder, rows, fields, plots (and their keys).
+#include "app/scene_readers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "common/case_file.hpp"
+#include "common/error.hpp"
+#include "common/region.hpp"
+#include "common/schema.hpp"
+#include <unistd.h>
+#include <cerrno>
+#include <cstring>
+
+namespace arlequin::app {
+namespace {
+
+constexpr KeyDoc sensor_keys[] = {
+    {"name", KeyType::string, "", {}, "", "column name (with _x, _y, _z per component)"},
+    {"type", KeyType::choice, "", {}, "", "what it measures", "force | displacement | velocity | energy | affine_deviation"},
+    {"on", KeyType::choice, "", {}, "(dem if the case has DEs)", "which model's group", "dem | continuum"},
+    {"group", KeyType::string, "", {}, "", "the group measured (reaction force, mean displacement or velocity, energy)"},
+    {"component", KeyType::choice, "", {}, "all", "one component, or all three", "x | y | z | all"},
+};
+constexpr KeyDoc check_keys[] = {
+    {"column", KeyType::string, "", {}, "", "the series.csv column judged"},
+    {"statistic", KeyType::choice, "", {}, "final", "what of the column is judged", "final | max | min | final_over_initial"},
+    {"crossing", KeyType::number, "column unit", {}, "(none)", "judge the time the column first reaches this value instead"},
+    {"expected", KeyType::number, "(the column's, or s)", {}, "(none)", "reference value (with tolerance)"},
+    {"tolerance", KeyType::number, "1", Range::positive(), "", "relative tolerance on expected"},
+    {"at_most", KeyType::number, "column unit", {}, "(none)", "upper bound (instead of expected)"},
+    {"at_least", KeyType::number, "column unit", {}, "(none)", "lower bound (instead of expected)"},
+    {"note", KeyType::string, "", {}, "", "where the reference comes from, shown with the result"},
+};
+constexpr KeyDoc output_keys[] = {
+    {"dir", KeyType::string, "", {}, "(results/<name>)", "output folder, relative to the working directory"},
+    {"every", KeyType::number, "s", Range::positive(), "(time.end / 100)", "interval of series.csv rows"},
+    {"fields", KeyType::strings, "", {}, "[]", "field sets written to fields.h5: particles, bonds, continuum"},
+    {"fields_every", KeyType::number, "s", Range::positive(), "(every)", "interval of fields.h5 frames"},
+    {"plots", KeyType::list, "", {}, "(none)", "plots of series columns, drawn by the Python package"},
+};
+constexpr KeyDoc plot_keys[] = {
+    {"file", KeyType::string, "", {}, "", "image name in the output folder: .png, .svg or .pdf"},
+    {"title", KeyType::string, "", {}, "", "title"},
+    {"x", KeyType::string, "", {}, "", "column on the x axis"},
+    {"x_scale", KeyType::number, "1", {}, "1", "factor on x (e.g. 1 / L for a strain)"},
+    {"x_label", KeyType::string, "", {}, "(x)", "x axis label"},
+    {"y", KeyType::strings, "", {}, "", "columns on the left axis"},
+    {"y_scale", KeyType::number, "1", {}, "1", "factor on the left axis' columns"},
+    {"y_label", KeyType::string, "", {}, "", "left axis label"},
+    {"y2", KeyType::strings, "", {}, "[]", "columns on the right axis"},
+    {"y2_scale", KeyType::number, "1", {}, "1", "factor on the right axis' columns"},
+    {"y2_label", KeyType::string, "", {}, "", "right axis label"},
+};
+
+constexpr SchemaSection output_sections[] = {
+    {"sensors[]", "a series.csv column (or three)", sensor_keys},
+    {"checks[]", "an acceptance check judged at time.end", check_keys},
+    {"output", "results", output_keys},
+    {"output.plots[]", "a plot of series columns", plot_keys},
+};
+
+}  // namespace
+
+std::span<const SchemaSection> output_schema() { return output_sections; }
+
+void read_sensors(CaseNode root, Scene& scene) {
+  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy", "affine_deviation"};
+  static constexpr std::string_view models[] = {"dem", "continuum"};
+  const bool has_dem = scene.dem.particles.size() > 0;
+  for (CaseNode s : root.list_or_empty("sensors")) {
+    Sensor sensor;
+    sensor.name = s.string("name");
+    if (sensor.name.empty() || sensor.name.find_first_of(", \"") != std::string::npos)
+      s.fail("name", "expected a non-empty name without commas, quotes or spaces");
+    for (const Sensor& other : scene.sensors)
+      if (other.name == sensor.name) s.fail("name", "sensor '" + sensor.name + "' is defined twice");
+    const std::string type = s.choice("type", types);
+    if (type == "affine_deviation") {
+      // A patch test's measure: the whole scene against the initial_strain field.
+      if (!scene.initial_gradient) s.fail("type", "an affine_deviation sensor needs an initial_strain section");
+      sensor.kind = Sensor::Kind::affine_deviation;
+      sensor.component = 0;
+      s.finish();
+      scene.sensors.push_back(sensor);
+      continue;
+    }
+    sensor.kind = type == "force"          ? Sensor::Kind::force
+                  : type == "displacement" ? Sensor::Kind::displacement
+                  : type == "velocity"     ? Sensor::Kind::velocity
+                                           : Sensor::Kind::energy;
+    sensor.on_continuum = s.choice_or("on", has_dem ? "dem" : "continuum", models) == "continuum";
+    if (sensor.on_continuum) {
+      if (!scene.continuum) s.fail("on", "the case has no continuum");
+      if (sensor.kind == Sensor::Kind::energy) s.fail("type", "energy sensors are for DEM groups");
+      sensor.group_name = s.string("group");
+      if (!scene.continuum->has_group(sensor.group_name))
+        s.fail("group", "the continuum mesh has no physical group '" + sensor.group_name + "'");
+    } else {
+      if (!has_dem) s.fail("on", "the case has no DEM");
+      sensor.group = group_of(s, scene.dem);
+      sensor.group_name = s.string("group");
+      if (sensor.kind == Sensor::Kind::force) scene.dem.watch_reaction(sensor.group);
+    }
+    if (sensor.kind == Sensor::Kind::energy) {
+      sensor.component = 0;  // a scalar: one column
+    } else {
+      const std::string c = s.choice_or("component", "all", component_names);
+      sensor.component = c == "all" ? -1 : c[0] - 'x';
+    }
+    s.finish();
+    scene.sensors.push_back(sensor);
+  }
+}
+
+void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& columns) {
+  for (CaseNode c : root.list_or_empty("checks")) {
+    Check check;
+    check.column = c.string("column");
+    if (std::find(columns.begin(), columns.end(), check.column) == columns.end()) {
+      std::string known;
+      for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
+      c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
+    }
+    static constexpr std::string_view statistics[] = {"final", "max", "min", "final_over_initial"};
+    if (c.has("crossing")) {
+      check.kind = Check::Kind::crossing;
+      check.threshold = c.number("crossing", Range::any(), "column unit");
+    } else {
+      const std::string statistic = c.choice_or("statistic", "final", statistics);
+      check.kind = statistic == "final"  ? Check::Kind::final_value
+                   : statistic == "max"  ? Check::Kind::maximum
+                   : statistic == "min"  ? Check::Kind::minimum
+                                         : Check::Kind::final_over_initial;
+    }
+    const char* unit = check.kind == Check::Kind::crossing ? "s" : "column unit";
+    check.bounded = c.has("at_most") || c.has("at_least");
+    if (check.bounded) {
+      if (c.has("expected")) c.fail("expected", "give either expected and tolerance, or at_most / at_least");
+      // Only the bounds given (an unbounded side has no number a case file could hold).
+      if (c.has("at_most")) check.at_most = c.number("at_most", Range::any(), unit);
+      if (c.has("at_least")) check.at_least = c.number("at_least", Range::any(), unit);
+    } else {
+      check.expected = c.number("expected", Range::any(), unit);
+      check.tolerance = c.number("tolerance", Range::positive(), "1");
+    }
+    check.note = c.string_or("note", "");
+    c.finish();
+    scene.checks.push_back(check);
+  }
+}
+
+namespace {
+// 'path', built by appending (GCC 12 warns falsely of overlapping copies in "'" + s + "'").
+std::string quoted(const std::filesystem::path& path) {
+  std::string text = "'";
+  text += path.string();
+  text += "'";
+  return text;
+}
+}  // namespace
+
+// The output folder (--out, else output.dir, else results/<name>), checked now (unless
+// options.check_output_dir is off, as for `check`), so that one that cannot be written is bad
+// input before any work. Nothing is created here; the run creates it.
+std::filesystem::path prepare_output_dir(std::optional<CaseNode> out, const std::string& name, const SceneOptions& options) {
+  std::filesystem::path dir = out ? out->string_or("dir", "results/" + name) : "results/" + name;
+  if (!options.out_dir.empty()) dir = options.out_dir;
+  if (!options.check_output_dir) return dir;
+  // The folder itself, or the nearest of its parents that exists, must be a folder we may write
+  // in and enter; a parent we may not look into is a problem of its own.
+  std::string problem;
+  std::error_code ec;
+  std::filesystem::path existing = std::filesystem::absolute(dir, ec);
+  for (;;) {
+    const auto status = std::filesystem::status(existing, ec);
+    if (std::filesystem::exists(status)) break;
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory) {
+      problem = quoted(existing) + ": " + ec.message();
+      break;
+    }
+    if (!existing.has_parent_path() || existing == existing.parent_path()) break;
+    existing = existing.parent_path();
+  }
+  if (problem.empty() && !std::filesystem::is_directory(existing, ec))
+    problem = quoted(existing) + " is not a folder";
+  else if (problem.empty() && access(existing.c_str(), W_OK | X_OK) != 0)
+    problem = quoted(existing) + " is not writable (" + std::strerror(errno) + ")";
+  if (!problem.empty()) {
+    const std::string message = "cannot write the outputs to '" + dir.string() + "': " + problem;
+    if (options.out_dir.empty() && out && out->has("dir")) out->fail("dir", message);
+    throw InputError((options.out_dir.empty() ? "output folder" : "--out") + std::string(": ") + message);
+  }
+  return dir;
+}
+
+void read_output(std::optional<CaseNode> out, Scene& scene) {
+  static constexpr std::string_view field_kinds[] = {"particles", "bonds", "continuum"};
+  OutputPlan& plan = scene.output;
+  plan.every = scene.end_time / 100.0;
+  if (out) {
+    plan.every = out->number_or("every", plan.every, Range::positive(), "s");
+    for (const std::string& f : out->strings_or("fields", {})) {
+      if (std::find(std::begin(field_kinds), std::end(field_kinds), f) == std::end(field_kinds))
+        out->fail("fields", "unknown field set '" + f + "' (expected particles, bonds, continuum)");
+      (f == "particles" ? plan.particle_fields : f == "bonds" ? plan.bond_fields : plan.continuum_fields) = true;
+    }
+    plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
+    for (CaseNode p : out->list_or_empty("plots")) {
+      PlotPlan plot;
+      plot.file = p.string("file");
+      const auto ext = plot.file.extension();
+      if ((ext != ".png" && ext != ".svg" && ext != ".pdf") || plot.file.has_parent_path())
+        p.fail("file", "expected a file name ending in .png, .svg or .pdf (written in the output folder)");
+      plot.title = p.string_or("title", "");
+      plot.x = p.string("x");
+      plot.x_scale = p.number_or("x_scale", 1.0, Range::any(), "1");
+      plot.x_label = p.string_or("x_label", plot.x);
+      plot.y = p.strings("y");
+      plot.y_scale = p.number_or("y_scale", 1.0, Range::any(), "1");
+      plot.y_label = p.string_or("y_label", "");
+      plot.y2 = p.strings_or("y2", {});
+      plot.y2_scale = p.number_or("y2_scale", 1.0, Range::any(), "1");
+      plot.y2_label = p.string_or("y2_label", "");
+      p.finish();
+      plan.plots.push_back(plot);
+    }
+    out->finish();
+  }
+}
+
+std::vector<std::string> series_columns(const Scene& scene) {
+  std::vector<std::string> columns{"time", "step"};
+  for (auto& c : sensor_columns(scene)) columns.push_back(c);
+  columns.insert(columns.end(), std::begin(energy_columns), std::end(energy_columns));
+  if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
+  if (scene.model->monitor()) columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
+  if (scene.dem.failure_enabled())
+    for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
+  return columns;
+}
+
+std::vector<std::string> sensor_columns(const Scene& scene) {
+  std::vector<std::string> out;
+  for (const Sensor& s : scene.sensors) {
+    if (s.component >= 0) {
+      out.push_back(s.name);
+    } else {
+      for (const char* axis : {"_x", "_y", "_z"}) out.push_back(s.name + axis);
+    }
+  }
+  return out;
+}
+
+
+}  // namespace arlequin::app
