@@ -16,7 +16,7 @@
 namespace arlequin::app {
 
 Override CalibrationSpec::bond_override(const std::string& leaf, double value) const {
-  return Override(bond_key + "." + leaf + "=" + format("%.17g", value), bond_origin);
+  return Override(bond_key + "." + leaf, value, bond_origin);
 }
 
 namespace {
@@ -422,7 +422,7 @@ static SceneOptions failure_target_options(const CalibrationSpec& spec, const Sc
   o.overrides.push_back(spec.bond_override("E_mu", E_mu));
   o.overrides.push_back(spec.bond_override("r_mu", r_mu));
   o.overrides.push_back(target.criterion == "bbf" ? spec.bond_override("sigma_f", s)
-                                                  : Override("dem.failure.rdef.threshold=" + format("%.17g", s)));
+                                                  : Override("dem.failure.rdef.threshold", s, "calibrate: target " + target.name));
   return o;
 }
 

@@ -22,7 +22,6 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-std::string number_text(double value) { return format("%.17g", value); }
 // The shortest text that reads back as the same double.
 std::string shortest(double value) {
   char buffer[32];
@@ -116,18 +115,21 @@ double affine_modulus(const dem::DemModel& model, const SampleGeometry& g, const
 std::string group_name(int axis, bool upper) { return "face_" + std::string(axis_names[axis]) + (upper ? "max" : "min"); }
 std::string displacement_column(int axis, bool upper) { return "u_" + group_name(axis, upper).substr(5); }
 
-// The slab of DE centres within one mean diameter of a face, as a case-file region.
-std::string slab_yaml(const SampleGeometry& g, int axis, bool upper) {
+// The origin that messages about a test's generated sections name.
+std::string generated_by(const LoadCase& load) { return "test " + load.name + " (generated)"; }
+
+CaseValue map(std::vector<std::pair<std::string, CaseValue>> entries) { return CaseValue::map(std::move(entries)); }
+
+// The slab of DE centres within one mean diameter of a face, as a group with a box region.
+CaseValue slab_group(const SampleGeometry& g, int axis, bool upper) {
   const double t = 2.0 * g.mean_radius;
-  std::string lo = "[", hi = "[";
+  Vec3 lo, hi;
   for (int k = 0; k < 3; ++k) {
-    double a = g.lower[k] - g.length(k), b = g.upper[k] + g.length(k);  // across the sample, with margin
-    if (k == axis && upper) a = g.upper[k] - t;
-    if (k == axis && !upper) b = g.lower[k] + t;
-    lo += (k ? ", " : "") + number_text(a);
-    hi += (k ? ", " : "") + number_text(b);
+    lo[k] = g.lower[k] - g.length(k), hi[k] = g.upper[k] + g.length(k);  // across the sample, with margin
+    if (k == axis && upper) lo[k] = g.upper[k] - t;
+    if (k == axis && !upper) hi[k] = g.lower[k] + t;
   }
-  return "{name: " + group_name(axis, upper) + ", region: {box: [" + lo + "], " + hi + "]]}}";
+  return map({{"name", group_name(axis, upper)}, {"region", map({{"box", CaseValue::list({lo, hi})}})}});
 }
 
 // The axes whose faces get slabs: the loaded one, and for tension the two lateral ones.
@@ -141,46 +143,58 @@ std::vector<int> slab_axes(const LoadCase& load) {
 
 // The slabs of the test's faces as groups, displacement sensors on every slab (the loaded
 // component on the loaded faces, the normal one on the others), force sensors on both
-// loaded faces; as --set overrides, with no checks of the case's own.
-std::vector<std::string> gauge_overrides(const SampleGeometry& g, const LoadCase& load) {
-  std::string groups, sensors;
+// loaded faces; no checks of the case's own.
+std::vector<Override> gauge_overrides(const SampleGeometry& g, const LoadCase& load) {
+  std::vector<CaseValue> groups, sensors;
   for (int k : slab_axes(load)) {
     for (bool upper : {false, true}) {
-      groups += (groups.empty() ? "" : ", ") + slab_yaml(g, k, upper);
+      groups.push_back(slab_group(g, k, upper));
       const int component = k == load.face ? load.direction : k;
-      sensors += (sensors.empty() ? "" : ", ") + std::string("{name: ") + displacement_column(k, upper) +
-                 ", type: displacement, group: " + group_name(k, upper) + ", component: " + std::string(axis_names[component]) + "}";
+      sensors.push_back(map({{"name", displacement_column(k, upper)},
+                             {"type", "displacement"},
+                             {"group", group_name(k, upper)},
+                             {"component", std::string(axis_names[component])}}));
     }
   }
   for (bool upper : {false, true})
-    sensors += std::string(", {name: ") + (upper ? "F_moved" : "F_held") + ", type: force, group: " +
-               group_name(load.face, upper) + ", component: " + std::string(axis_names[load.direction]) + "}";
-  return {"groups=[" + groups + "]", "sensors=[" + sensors + "]", "checks=[]"};
+    sensors.push_back(map({{"name", upper ? "F_moved" : "F_held"},
+                           {"type", "force"},
+                           {"group", group_name(load.face, upper)},
+                           {"component", std::string(axis_names[load.direction])}}));
+  const std::string origin = generated_by(load);
+  return {Override("groups", CaseValue::list(groups), origin), Override("sensors", CaseValue::list(sensors), origin),
+          Override("checks", CaseValue::list({}), origin)};
 }
 
-std::string vec3_yaml(const Vec3& v) { return "[" + number_text(v.x) + ", " + number_text(v.y) + ", " + number_text(v.z) + "]"; }
-
-// The generated sections of one quasi-static test (header), as --set overrides.
-std::vector<std::string> test_overrides(const SampleGeometry& g, const LoadCase& load, const QuasiStatic& plan,
-                                        double transit, double damping) {
-  const std::string axis(axis_names[load.face]);
+// The generated sections of one quasi-static test (header).
+std::vector<Override> test_overrides(const SampleGeometry& g, const LoadCase& load, const QuasiStatic& plan, double transit,
+                                     double damping) {
+  const CaseValue axis = CaseValue::list({std::string(axis_names[load.face])});
   Vec3 motion{};
   motion[load.direction] = plan.strain * g.length(load.face);
-  const std::string value = vec3_yaml(motion);
-  const std::string ramp = number_text(plan.ramp * transit);
-  const std::string boundary =
-      load.shear() ? "[{group: " + group_name(load.face, false) + ", type: fixed}, {group: " + group_name(load.face, true) +
-                         ", type: displacement, value: " + value + ", ramp: " + ramp + ", rotation: fixed}]"
-                   : "[{group: " + group_name(load.face, false) + ", type: velocity, value: [0, 0, 0], components: [" + axis +
-                         "]}, {group: " + group_name(load.face, true) + ", type: displacement, value: " + value +
-                         ", ramp: " + ramp + ", components: [" + axis + "]}]";
-  std::vector<std::string> o = gauge_overrides(g, load);
-  o.insert(o.end(), {"boundary=" + boundary, "time.end=" + number_text((plan.ramp + plan.plateau) * transit),
-                     "output.every=" + number_text(transit / plan.rows_per_transit), "dem.damping=" + number_text(damping)});
+  const double ramp = plan.ramp * transit;
+  const CaseValue boundary =
+      load.shear()
+          ? CaseValue::list({map({{"group", group_name(load.face, false)}, {"type", "fixed"}}),
+                             map({{"group", group_name(load.face, true)},
+                                  {"type", "displacement"},
+                                  {"value", motion},
+                                  {"ramp", ramp},
+                                  {"rotation", "fixed"}})})
+          : CaseValue::list({map({{"group", group_name(load.face, false)}, {"type", "velocity"}, {"value", Vec3{}}, {"components", axis}}),
+                             map({{"group", group_name(load.face, true)},
+                                  {"type", "displacement"},
+                                  {"value", motion},
+                                  {"ramp", ramp},
+                                  {"components", axis}})});
+  const std::string origin = generated_by(load);
+  std::vector<Override> o = gauge_overrides(g, load);
+  o.insert(o.end(), {Override("boundary", boundary, origin), Override("time.end", (plan.ramp + plan.plateau) * transit, origin),
+                     Override("output.every", transit / plan.rows_per_transit, origin), Override("dem.damping", damping, origin)});
   return o;
 }
 
-// Mean reference coordinate along `axis` of the DEs of a face slab (those slab_yaml selects).
+// Mean reference coordinate along `axis` of the DEs of a face slab (those slab_group selects).
 double centroid(const dem::ParticleSet& p, const SampleGeometry& g, int axis, bool upper) {
   const double t = 2.0 * g.mean_radius;
   double s = 0.0;
@@ -479,7 +493,7 @@ struct TestSetup {
     write_json_atomically(scene.output.dir / "test.json", j);
   }
   // Builds and runs the test scene: the probe's options plus `generated`.
-  std::pair<Scene, RunResult> run(const std::filesystem::path& case_file, const std::vector<std::string>& generated,
+  std::pair<Scene, RunResult> run(const std::filesystem::path& case_file, const std::vector<Override>& generated,
                                   const RunOptions& run_options = {}) const {
     SceneOptions o = options;
     o.overrides.insert(o.overrides.end(), generated.begin(), generated.end());
@@ -634,25 +648,42 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
   // Displacement v (t - rise / 2) after the rise: the end strain is max_strain_factor x expected.
   const double rise = plan.rise * setup.transit;
   const double end = plan.max_strain_factor * plan.expected_strain * g.length(a) / r.velocity + 0.5 * rise;
-  const std::string axis(axis_names[a]);
+  const CaseValue axis = CaseValue::list({std::string(axis_names[a])});
   Vec3 velocity{};
   velocity[a] = r.velocity;
-  std::string sets;
-  for (const auto& set : setup.probe.dem.bond_sets()) sets += (sets.empty() ? "" : ", ") + ("broken_" + set->name);
-  std::vector<std::string> generated = gauge_overrides(g, load);
-  generated.insert(generated.end(),
-                   {"boundary=[{group: " + group_name(a, false) + ", type: velocity, value: [0, 0, 0], components: [" + axis +
-                        "]}, {group: " + group_name(a, true) + ", type: velocity, value: " + vec3_yaml(velocity) +
-                        ", rise: " + number_text(rise) + ", components: [" + axis + "]}]",
-                    "time.end=" + number_text(end), "output.every=" + number_text(setup.transit / plan.rows_per_transit),
-                    "dem.damping=" + number_text(setup.damping),
-                    // Seed Figs. 5-6: broken bonds per group and the stress against the strain.
-                    "output.plots=[{file: failure.png, title: 'Tension to failure: " + load.name + "', x: " +
-                        displacement_column(a, true) + ", x_scale: " + number_text(1.0 / gauge) +
-                        ", x_label: strain, y: [F_moved], y_scale: " + number_text(1e-9 / area) +
-                        ", y_label: stress GPa, y2: [" + sets + "], y2_scale: 100, y2_label: broken bonds %}]"});
+  std::vector<CaseValue> broken;
+  for (const auto& set : setup.probe.dem.bond_sets()) broken.push_back("broken_" + set->name);
+  const std::string origin = generated_by(load);
+  std::vector<Override> generated = gauge_overrides(g, load);
+  generated.insert(
+      generated.end(),
+      {Override("boundary",
+                CaseValue::list({map({{"group", group_name(a, false)}, {"type", "velocity"}, {"value", Vec3{}}, {"components", axis}}),
+                                 map({{"group", group_name(a, true)},
+                                      {"type", "velocity"},
+                                      {"value", velocity},
+                                      {"rise", rise},
+                                      {"components", axis}})}),
+                origin),
+       Override("time.end", end, origin), Override("output.every", setup.transit / plan.rows_per_transit, origin),
+       Override("dem.damping", setup.damping, origin),
+       // Seed Figs. 5-6: broken bonds per group and the stress against the strain.
+       Override("output.plots",
+                CaseValue::list({map({{"file", "failure.png"},
+                                      {"title", "Tension to failure: " + load.name},
+                                      {"x", displacement_column(a, true)},
+                                      {"x_scale", 1.0 / gauge},
+                                      {"x_label", "strain"},
+                                      {"y", CaseValue::list({"F_moved"})},
+                                      {"y_scale", 1e-9 / area},
+                                      {"y_label", "stress GPa"},
+                                      {"y2", CaseValue::list(broken)},
+                                      {"y2_scale", 100},
+                                      {"y2_label", "broken bonds %"}})}),
+                origin)});
   if (plan.frames > 0)
-    generated.insert(generated.end(), {"output.fields=[particles, bonds]", "output.fields_every=" + number_text(end / plan.frames)});
+    generated.insert(generated.end(), {Override("output.fields", CaseValue::list({"particles", "bonds"}), origin),
+                                       Override("output.fields_every", end / plan.frames, origin)});
 
   // The stress on the moved face, row by row; stop once it has fallen well below its peak.
   FailureStop stop(plan);

@@ -197,6 +197,24 @@ std::string read_text(const std::filesystem::path& file) {
 }
 
 // Applies one "a.b.c=value" override: replaces or creates the key, creating mappings on the way.
+// A generated value as a YAML node: scalars are plain text (a number in its exact form), as a
+// case file would give them.
+YAML::Node to_yaml(const CaseValue& v) {
+  switch (v.kind()) {
+    case CaseValue::Kind::number:
+    case CaseValue::Kind::text: return YAML::Node(v.text());
+    case CaseValue::Kind::list: {
+      YAML::Node list(YAML::NodeType::Sequence);
+      for (const CaseValue& item : v.items()) list.push_back(to_yaml(item));
+      return list;
+    }
+    case CaseValue::Kind::map: break;
+  }
+  YAML::Node map(YAML::NodeType::Map);
+  for (const auto& [key, value] : v.entries()) map[key] = to_yaml(value);
+  return map;
+}
+
 void apply_override(detail::CaseState& s, const Override& o) {
   const std::string& text = o.text;
   const std::string where = o.where();
@@ -213,6 +231,7 @@ void apply_override(detail::CaseState& s, const Override& o) {
     start = dot + 1;
   }
   const YAML::Node value = [&] {
+    if (o.value) return to_yaml(*o.value);
     try {
       return YAML::Load(text.substr(eq + 1));
     } catch (const YAML::Exception& e) {
@@ -242,6 +261,32 @@ void apply_override(detail::CaseState& s, const Override& o) {
 }
 
 }  // namespace
+
+// ---- CaseValue ------------------------------------------------------------------------
+
+CaseValue::CaseValue(double number) : kind_(Kind::number), text_(format_number(number)) {}
+
+CaseValue::CaseValue(const Vec3& v) : kind_(Kind::list), items_{CaseValue(v.x), CaseValue(v.y), CaseValue(v.z)} {}
+
+CaseValue CaseValue::list(std::vector<CaseValue> items) {
+  CaseValue v(Kind::list);
+  v.items_ = std::move(items);
+  return v;
+}
+
+CaseValue CaseValue::map(std::vector<std::pair<std::string, CaseValue>> entries) {
+  CaseValue v(Kind::map);
+  v.entries_ = std::move(entries);
+  return v;
+}
+
+std::string CaseValue::yaml() const {
+  YAML::Emitter out;
+  out.SetSeqFormat(YAML::Flow);
+  out.SetMapFormat(YAML::Flow);
+  out << to_yaml(*this);
+  return out.c_str();
+}
 
 // ---- Range, edit distance --------------------------------------------------------------
 

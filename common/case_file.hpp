@@ -56,14 +56,45 @@ struct CaseState;
 struct CaseRecord;
 }  // namespace detail
 
-// One "a.b.c=value" override of a case (the value is parsed as YAML) and where it was given:
-// "--set" (the command line, the default), "--over", or a spec file's line and key, e.g.
-// "spec.yaml:14: samples[1].set". Messages about what it set name that origin.
+// A value built in code for an override, so that generated sections are data, not YAML text:
+// a number (every bit kept), a word, [x, y, z], a list or a mapping.
+class CaseValue {
+ public:
+  CaseValue(double number);
+  CaseValue(int number) : CaseValue(static_cast<double>(number)) {}
+  CaseValue(const char* text) : CaseValue(std::string(text)) {}
+  CaseValue(std::string text) : kind_(Kind::text), text_(std::move(text)) {}
+  CaseValue(const Vec3& v);
+  static CaseValue list(std::vector<CaseValue> items);
+  static CaseValue map(std::vector<std::pair<std::string, CaseValue>> entries);
+
+  enum class Kind { number, text, list, map };
+  Kind kind() const { return kind_; }
+  const std::string& text() const { return text_; }  // number (shortest exact form) or text
+  const std::vector<CaseValue>& items() const { return items_; }
+  const std::vector<std::pair<std::string, CaseValue>>& entries() const { return entries_; }
+  std::string yaml() const;  // in YAML flow style, for messages
+
+ private:
+  CaseValue(Kind kind) : kind_(kind) {}
+  Kind kind_;
+  std::string text_;
+  std::vector<CaseValue> items_;
+  std::vector<std::pair<std::string, CaseValue>> entries_;
+};
+
+// One "a.b.c=value" override of a case (the value is parsed as YAML, or given as a CaseValue)
+// and where it was given: "--set" (the command line, the default), "--over", a spec file's line
+// and key, e.g. "spec.yaml:14: samples[1].set", or the code that generated it. Messages about
+// what it set name that origin.
 struct Override {
-  std::string text;
+  std::string text;  // "key.path=value" as given, or as the value's YAML
   std::string origin = "--set";
+  std::shared_ptr<const CaseValue> value;  // the value as data (then not parsed from text)
   Override(std::string text_, std::string origin_ = "--set") : text(std::move(text_)), origin(std::move(origin_)) {}
   Override(const char* text_) : text(text_) {}
+  Override(const std::string& key_path, CaseValue value_, std::string origin_)
+      : text(key_path + "=" + value_.yaml()), origin(std::move(origin_)), value(std::make_shared<const CaseValue>(std::move(value_))) {}
   std::string where() const { return origin.starts_with("--") ? origin + " " + text : origin + ": " + text; }
 };
 

@@ -640,6 +640,7 @@ TEST(Runner, SigtermEndsTheCommandWithItsExitCode) {
   EXPECT_TRUE(no_temporary_files(out));
 }
 
+#ifdef ARLEQUIN_WITH_CONTINUUM
 // Output rows do not change the motion of a coupled run, and their energies are those of a
 // bond pass. The coupled wave bar for 300 steps with a row every ~3.4 steps (the case's) and
 // with rows only at the start and the end, with fe and with nem: the same DEs and continuum
@@ -681,6 +682,7 @@ TEST(Runner, OutputRowsLeaveTheCoupledMotionUnchanged) {
     EXPECT_EQ(dense.result.sensors, sparse.result.sensors) << solver;
   }
 }
+#endif
 
 }  // namespace
 }  // namespace arlequin
