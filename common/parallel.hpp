@@ -15,27 +15,23 @@ namespace arlequin {
 inline constexpr long parallel_threshold = 4096;
 // The same for bonds, per colour of a bond set on average (dem::BondColouring). A bond costs
 // 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
-// hundred to a few thousand bonds, which parallel_threshold kept on one thread (the 10k REV:
-// 3.3 ms per step on 2 threads against 1.8 ms at 512, 2026-11-25). 256, not 512, also puts the
-// 10k REV's smaller sets on threads (2 threads: 1.62 -> 1.53 ms per step, arlequin run
-// cases/rev_elastic, 2026-11-25; with the bond kernel of 2026-11-26, 0.62-0.68 -> 0.54-0.56 ms,
-// bench_bonded_block 200 cases/rev_elastic/case.yaml).
+// hundred to a few thousand bonds, which parallel_threshold would keep on one thread; 256 puts
+// the 10k REV's sets on threads too (bench_bonded_block with cases/rev_elastic/case.yaml shows
+// the gain; the figures are in the commit that set it).
 inline constexpr long parallel_threshold_bonds = 256;
 // ... and only in a scene of more DEs than this. Below it the DEs' state sits in one core's
 // cache, and a second thread moves more of it between the cores than it takes bonds off the
-// first. The coupled wave bar's lattice (775 DEs, 6 colours of ~330 bonds), bench_coupled_step
-// on 2 threads, 2026-11-26: 60-67 us per step with its bonds on one thread against 73-81 us on
-// both (six alternations); a second set, twelve alternations, 61-86 us (median 76) against
-// 79-88 us (median 82). The all-DEM bar (2975 DEs, colours of ~1280 bonds) gains from the
-// second thread (0.129-0.143 -> 0.114-0.119 ms per step, bench_bonded_block), as the REVs do.
+// first: the coupled wave bar's lattice (775 DEs, 6 colours of ~330 bonds) steps faster with its
+// bonds on one thread, while the all-DEM bar (2975 DEs, colours of ~1280 bonds) gains from the
+// second (bench_coupled_step, bench_bonded_block).
 inline constexpr long parallel_threshold_bond_particles = 2048;
 
 // Runs loop() on the OpenMP threads if `threaded` and there is more than one, else in the
 // calling thread; loop() holds orphaned `omp for` loops, which split over the team inside the
 // region and run whole outside it. Not entering OpenMP at all is the point: a parallel region
-// whose `if` clause is false still starts a team of one, ~1.2 us each with GCC 12's libgomp on
-// the 2-core VM (bench_omp_regions), where an orphaned loop outside any region costs ~8 ns;
-// the coupled wave bar's five such regions a step cost it ~22 us of 66 (2026-11-26). Not for
+// whose `if` clause is false still starts a team of one, which costs about a hundred times an
+// orphaned loop outside any region (bench_omp_regions prints both); a small coupled step enters
+// several such regions, and paid for them a third of its time. Not for
 // use inside a parallel region: an orphaned loop there would split over the enclosing team, or
 // hang if only some of its threads reach it (none of ours nests).
 template <class Loop>

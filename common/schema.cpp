@@ -41,7 +41,8 @@ std::string Schema::describe(std::string_view prefix) const {
   std::string out;
   for (const SchemaSection& s : sections_) {
     if (!s.path.starts_with(prefix)) continue;
-    out += (out.empty() ? "" : "\n") + std::string(s.path) + ": " + std::string(s.help) + "\n";
+    if (!out.empty()) out += '\n';
+    out.append(s.path).append(": ").append(s.help).append("\n");
     for (const KeyDoc& k : s.keys) {
       std::string type(name_of(k.type));
       if (k.type == KeyType::choice) type = std::string(k.values);

@@ -54,9 +54,7 @@ void apply_order(std::vector<T>& v, std::span<const std::uint32_t> order) {
 // Runs body(first, last) over blocks of at most `block` consecutive bonds [first, last) of one
 // colour, colour by colour, each colour's blocks split over threads if colouring.threaded. One
 // team of threads serves all colours, with a barrier between colours, rather than a team
-// started per colour (the coupled wave bar's lattice, 6 colours of 174-387 bonds, then on
-// threads, 2 threads: 151-162 us per step before, 150-154 us after, bench_coupled_step,
-// 2026-11-25).
+// started per colour.
 template <class Body>
 void for_each_bond_block(const BondColouring& colouring, long block, Body&& body) {
   const long colours = static_cast<long>(colouring.offsets.size()) - 1;

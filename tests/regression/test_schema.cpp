@@ -91,13 +91,14 @@ TEST(Schema, TheCommandPrintsTheDeclaredSections) {
     EXPECT_NE(all.output.find(std::string(section.path) + ": " + std::string(section.help) + "\n"), std::string::npos) << section.path;
   EXPECT_NE(all.output.find("bond (law: beam): "), std::string::npos);
   EXPECT_NE(all.output.find("  E_mu                number > 0 [Pa]"), std::string::npos) << all.output;
-  const auto coupling = test::run_arlequin("schema coupling", "stdout");
-  ASSERT_EQ(coupling.exit_code, 0);
-  EXPECT_NE(coupling.output.find("coupling.overlap: "), std::string::npos);
-  EXPECT_EQ(coupling.output.find("dem: "), std::string::npos) << coupling.output;
-  const auto unknown = test::run_arlequin("schema coupl.overlap");
+  const auto sample = test::run_arlequin("schema dem.sample", "stdout");
+  ASSERT_EQ(sample.exit_code, 0);
+  EXPECT_NE(sample.output.find("dem.sample.radius: "), std::string::npos);
+  EXPECT_EQ(sample.output.find("dem: "), std::string::npos) << sample.output;
+  EXPECT_EQ(sample.output.find("time: "), std::string::npos) << sample.output;
+  const auto unknown = test::run_arlequin("schema dem.smaple");
   EXPECT_EQ(unknown.exit_code, 2);
-  EXPECT_NE(unknown.output.find("no section 'coupl.overlap'; did you mean 'coupling.overlap'?"), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find("no section 'dem.smaple'; did you mean 'dem.sample'?"), std::string::npos) << unknown.output;
 }
 
 }  // namespace
