@@ -110,6 +110,149 @@ continuum::Material read_material(CaseNode m) {
   return material;
 }
 
+// What continuum: says, read before anything is built.
+struct ContinuumBoundary {
+  CaseNode node;  // where its errors are: its group is checked once the mesh is read
+  std::string group{};
+  std::string kind{};  // fixed | displacement | velocity | traction
+  Vec3 value{};        // m, m/s or Pa by kind
+  std::array<bool, 3> components{true, true, true};
+  double rise = 0.0, duration = INFINITY;  // velocity, s
+};
+struct ContinuumCaseSettings {
+  CaseNode mesh_node;  // where mesh errors are reported
+  std::string solver_name{};
+  continuum::ContinuumSettings solver{};
+  bool is_static = false;
+  std::vector<ContinuumBoundary> boundaries{};
+};
+// What coupling: says; its overlap zone is built (and so checked) as it is read.
+struct CouplingCaseSettings {
+  CaseNode node;  // the section: the coupling library's errors are reported at their key
+  coupling::OverlapZone zone;
+  coupling::CoupledOptions options{};
+};
+
+// An error of the coupling library at its key in the case's coupling section: a SettingError
+// names the key (quadrature, petsc_options, mass_floor, ...); any other is about the overlap.
+[[noreturn]] void fail_at_coupling_key(const CaseNode& section, const InputError& e) {
+  if (const auto* setting = dynamic_cast<const SettingError*>(&e)) section.fail(setting->key(), setting->message());
+  section.fail("overlap", e.what());
+}
+
+ContinuumBoundary read_continuum_boundary(CaseNode bc) {
+  static constexpr std::string_view kinds[] = {"fixed", "displacement", "velocity", "traction"};
+  ContinuumBoundary out{bc};
+  out.group = bc.string("group");
+  out.kind = bc.choice("type", kinds);
+  if (out.kind == "traction") {
+    out.value = bc.vec3("value", Range::any(), "Pa");
+    bc.finish();
+    return out;
+  }
+  if (bc.has("components")) {
+    out.components = {false, false, false};
+    for (const std::string& c : bc.strings("components")) {
+      if (c != "x" && c != "y" && c != "z") bc.fail("components", "expected a list of x, y, z, got '" + c + "'");
+      out.components[c[0] - 'x'] = true;
+    }
+  }
+  if (out.kind == "displacement") {
+    out.value = bc.vec3("value", Range::any(), "m");
+  } else if (out.kind == "velocity") {
+    out.value = bc.vec3("value", Range::any(), "m/s");
+    out.rise = bc.number_or("rise", 0.0, Range::non_negative(), "s");
+    out.duration = bc.number_or("duration", INFINITY, Range::positive(), "s");
+    if (out.rise > out.duration) bc.fail("rise", "the rise time must not exceed the duration");
+  }
+  bc.finish();
+  return out;
+}
+
+ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_petsc_options) {
+  std::vector<std::string_view> names;
+  for (const auto& e : continuum::continuum_solvers()) names.push_back(e.name);
+  std::string name = section.choice("solver", names);
+  CaseNode mesh = section.child("mesh");
+  ContinuumCaseSettings out{mesh, std::move(name)};
+  out.solver.mesh.path = mesh.existing_file("file").string();
+  out.solver.mesh.size = mesh.number_or("size", 0.0, Range::non_negative(), "m");
+  out.solver.mesh.order = int(mesh.integer_or("order", 1, Range::between(1, 2)));
+  mesh.finish();
+  out.solver.materials.push_back({"", read_material(section.child("material"))});
+  static constexpr std::string_view shapes[] = {"sibson", "laplace"};
+  out.solver.shape_functions = section.choice_or("shape_functions", "sibson", shapes);
+  out.solver.nem_stabilization = section.number_or("stabilization", 1.0, Range::positive(), "1");
+  out.solver.petsc_options = section.string_or("petsc_options", "") + " " + extra_petsc_options;
+  static constexpr std::string_view analyses[] = {"explicit", "static"};
+  out.is_static = section.choice_or("analysis", "explicit", analyses) == "static";
+  for (CaseNode bc : section.list_or_empty("boundary")) out.boundaries.push_back(read_continuum_boundary(bc));
+  section.finish();
+  return out;
+}
+
+coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone::Weighting& weighting) {
+  static constexpr std::string_view axes[] = {"x", "y", "z"};
+  static constexpr std::string_view box_sides[] = {"lower", "upper"};
+  static constexpr std::string_view cylinder_sides[] = {"base", "top"};
+  if (overlap.has("shell")) {
+    CaseNode shell = overlap.child("shell");
+    const auto inner = shell.vec3_list("inner", Range::any(), "m"), outer = shell.vec3_list("outer", Range::any(), "m");
+    if (inner.size() != 2 || outer.size() != 2) shell.fail("inner", "expected two boxes [[x0,y0,z0],[x1,y1,z1]]");
+    shell.finish();
+    overlap.finish();
+    return coupling::OverlapZone::shell(Box{inner[0], inner[1]}, Box{outer[0], outer[1]}, weighting);
+  }
+  const Region region = Region::read(overlap);
+  if (const auto* box = std::get_if<Box>(&region.shape())) {
+    const int axis = overlap.choice("axis", axes)[0] - 'x';
+    const bool lower = overlap.choice("dem_side", box_sides) == "lower";
+    overlap.finish();
+    return coupling::OverlapZone::box(*box, axis, lower, weighting);
+  }
+  if (const auto* cylinder = std::get_if<Cylinder>(&region.shape())) {
+    if (cylinder->length < 0.0) overlap.fail("cylinder", "an overlap cylinder needs a length");
+    const bool base = overlap.choice("dem_side", cylinder_sides) == "base";
+    overlap.finish();
+    return coupling::OverlapZone::cylinder(*cylinder, base, weighting);
+  }
+  overlap.fail("box", "an overlap is a box, a cylinder or a shell");
+}
+
+
+CouplingCaseSettings read_coupling(CaseNode section) {
+  coupling::OverlapZone::Weighting weighting;
+  static constexpr std::string_view shapes[] = {"linear", "cubic", "constant"};
+  weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
+  weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
+  weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
+  CaseNode overlap = section.child("overlap");
+  std::optional<coupling::OverlapZone> zone;
+  try {
+    zone = read_overlap(overlap, weighting);
+  } catch (const InputError& e) {  // the zone's own checks (extents, inner and outer boxes)
+    fail_at_coupling_key(section, e);
+  }
+  CouplingCaseSettings out{section, *zone};
+  static constexpr std::string_view mediators[] = {"coarse", "fine"};
+  static constexpr std::string_view types[] = {"l2", "h1"};
+  out.options.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
+  out.options.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
+  if (out.options.coupling.type == coupling::CouplingType::h1)
+    out.options.coupling.length = section.number("length", Range::positive(), "m");
+  static constexpr std::string_view quadratures[] = {"plain", "consistent"};
+  out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
+  static constexpr std::string_view solvers[] = {"petsc", "direct"};
+  if (section.choice_or("solver", "petsc", solvers) == "petsc")
+    out.options.multiplier_petsc_options = section.string_or("petsc_options", "");
+  else if (section.has("petsc_options"))
+    section.fail("petsc_options", "is read by coupling.solver: petsc only (the direct solver has no options)");
+  else
+    out.options.multiplier_petsc_options.reset();
+  section.finish();
+  return out;
+}
+
 // Both models advanced together by the Arlequin coupling (coupling::CoupledModel), which
 // finalized the DEM; the continuum part keeps its solver, this model the coupling.
 class Coupled final : public SceneModel {
@@ -140,39 +283,21 @@ class Coupled final : public SceneModel {
 
 class Part final : public ContinuumPart {
  public:
-  Part(CaseNode section, std::optional<CaseNode> coupling, const std::string& extra_petsc_options) {
-    std::vector<std::string_view> names;
-    for (const auto& e : continuum::continuum_solvers()) names.push_back(e.name);
-    const std::string name = section.choice("solver", names);
-    continuum::ContinuumSettings settings;
-    CaseNode mesh = section.child("mesh");
-    settings.mesh.path = mesh.existing_file("file").string();
-    settings.mesh.size = mesh.number_or("size", 0.0, Range::non_negative(), "m");
-    settings.mesh.order = int(mesh.integer_or("order", 1, Range::between(1, 2)));
-    mesh.finish();
-    settings.materials.push_back({"", read_material(section.child("material"))});
-    static constexpr std::string_view shapes[] = {"sibson", "laplace"};
-    settings.shape_functions = section.choice_or("shape_functions", "sibson", shapes);
-    settings.nem_stabilization = section.number_or("stabilization", 1.0, Range::positive(), "1");
-    settings.petsc_options = section.string_or("petsc_options", "") + " " + extra_petsc_options;
-    static constexpr std::string_view analyses[] = {"explicit", "static"};
-    static_ = section.choice_or("analysis", "explicit", analyses) == "static";
-    petsc_options_ = settings.petsc_options;
+  Part(ContinuumCaseSettings settings, std::optional<CouplingCaseSettings> coupling)
+      : static_(settings.is_static), petsc_options_(settings.solver.petsc_options) {
     if (coupling) {
-      coupling_ = coupling;
-      if (static_) coupling->fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
-      read_coupling(*coupling);
-      settings.mesh.left_out = [zone = *zone_](const Vec3& x) { return zone.in_pure_dem_zone(x); };
-      settings.mesh.left_out_name =
-          "the pure-DEM zone of coupling.overlap (" + coupling_->where("overlap") + ": " + zone_->description() + ")";
+      coupling_ = std::move(coupling);
+      const coupling::OverlapZone& zone = coupling_->zone;
+      settings.solver.mesh.left_out = [zone](const Vec3& x) { return zone.in_pure_dem_zone(x); };
+      settings.solver.mesh.left_out_name =
+          "the pure-DEM zone of coupling.overlap (" + coupling_->node.where("overlap") + ": " + zone.description() + ")";
     }
     try {
-      solver_ = continuum::make_continuum_solver(name, settings);
+      solver_ = continuum::make_continuum_solver(settings.solver_name, settings.solver);
     } catch (const InputError& e) {
-      mesh.fail("file", e.what());
+      settings.mesh_node.fail("file", e.what());
     }
-    for (CaseNode bc : section.list_or_empty("boundary")) read_boundary(bc);
-    section.finish();
+    for (const ContinuumBoundary& bc : settings.boundaries) apply_boundary(bc);
   }
 
   ContinuumSolver& solver() override { return *solver_; }
@@ -189,14 +314,15 @@ class Part final : public ContinuumPart {
     solver_->set_initial_displacement(u);
   }
 
-  bool in_dem_domain(const Vec3& x) const override { return !zone_ || zone_->in_dem_domain(x); }
+  bool in_dem_domain(const Vec3& x) const override { return !coupling_ || coupling_->zone.in_dem_domain(x); }
   std::unique_ptr<SceneModel> couple(dem::DemModel& dem) override {
-    options_.held_continuum_dofs = held_dofs_;
-    options_.driven_des = dem.driven_particles();
+    coupling::CoupledOptions options = coupling_->options;
+    options.held_continuum_dofs = held_dofs_;
+    options.driven_des = dem.driven_particles();
     try {
-      return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, *zone_, options_));
+      return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, coupling_->zone, options));
     } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses, quadrature)
-      fail_at_coupling_key(e);
+      fail_at_coupling_key(coupling_->node, e);
     }
   }
   void solve_static() override { solver_->solve_static(petsc_options_); }
@@ -261,43 +387,6 @@ class Part final : public ContinuumPart {
   }
 
  private:
-  void read_coupling(CaseNode section) {
-    coupling::OverlapZone::Weighting weighting;
-    static constexpr std::string_view shapes[] = {"linear", "cubic", "constant"};
-    weighting.shape = coupling::weight_shape_from_name(section.choice_or("weight", "linear", shapes));
-    weighting.constant_value = section.number_or("constant_value", 0.5, Range::open_between(0.0, 1.0), "1");
-    weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
-    CaseNode overlap = section.child("overlap");
-    try {
-      zone_ = read_overlap(overlap, weighting);
-    } catch (const InputError& e) {  // the zone's own checks (extents, inner and outer boxes)
-      fail_at_coupling_key(e);
-    }
-    static constexpr std::string_view mediators[] = {"coarse", "fine"};
-    static constexpr std::string_view types[] = {"l2", "h1"};
-    options_.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
-    options_.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
-    if (options_.coupling.type == coupling::CouplingType::h1)
-      options_.coupling.length = section.number("length", Range::positive(), "m");
-    static constexpr std::string_view quadratures[] = {"plain", "consistent"};
-    options_.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
-    static constexpr std::string_view solvers[] = {"petsc", "direct"};
-    if (section.choice_or("solver", "petsc", solvers) == "petsc")
-      options_.multiplier_petsc_options = section.string_or("petsc_options", "");
-    else if (section.has("petsc_options"))
-      section.fail("petsc_options", "is read by coupling.solver: petsc only (the direct solver has no options)");
-    else
-      options_.multiplier_petsc_options.reset();
-    section.finish();
-  }
-
-  // An error of the coupling library at its key in the case: a SettingError names the key
-  // (quadrature, petsc_options, mass_floor, ...); any other is about the overlap.
-  [[noreturn]] void fail_at_coupling_key(const InputError& e) const {
-    if (const auto* setting = dynamic_cast<const SettingError*>(&e)) coupling_->fail(setting->key(), setting->message());
-    coupling_->fail("overlap", e.what());
-  }
-
   static Vec3 node_vector(const continuum::Field& f, int n) { return {f[3 * n], f[3 * n + 1], f[3 * n + 2]}; }
   Vec3 node_mean(const continuum::Field& f, const std::string& group) const {
     const auto& nodes = solver_->mesh().group(group).nodes;
@@ -311,84 +400,37 @@ class Part final : public ContinuumPart {
     return out;
   }
 
-  static coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone::Weighting& weighting) {
-    static constexpr std::string_view axes[] = {"x", "y", "z"};
-    static constexpr std::string_view box_sides[] = {"lower", "upper"};
-    static constexpr std::string_view cylinder_sides[] = {"base", "top"};
-    if (overlap.has("shell")) {
-      CaseNode shell = overlap.child("shell");
-      const auto inner = shell.vec3_list("inner", Range::any(), "m"), outer = shell.vec3_list("outer", Range::any(), "m");
-      if (inner.size() != 2 || outer.size() != 2) shell.fail("inner", "expected two boxes [[x0,y0,z0],[x1,y1,z1]]");
-      shell.finish();
-      overlap.finish();
-      return coupling::OverlapZone::shell(Box{inner[0], inner[1]}, Box{outer[0], outer[1]}, weighting);
-    }
-    const Region region = Region::read(overlap);
-    if (const auto* box = std::get_if<Box>(&region.shape())) {
-      const int axis = overlap.choice("axis", axes)[0] - 'x';
-      const bool lower = overlap.choice("dem_side", box_sides) == "lower";
-      overlap.finish();
-      return coupling::OverlapZone::box(*box, axis, lower, weighting);
-    }
-    if (const auto* cylinder = std::get_if<Cylinder>(&region.shape())) {
-      if (cylinder->length < 0.0) overlap.fail("cylinder", "an overlap cylinder needs a length");
-      const bool base = overlap.choice("dem_side", cylinder_sides) == "base";
-      overlap.finish();
-      return coupling::OverlapZone::cylinder(*cylinder, base, weighting);
-    }
-    overlap.fail("box", "an overlap is a box, a cylinder or a shell");
-  }
-
-  void read_boundary(CaseNode bc) {
-    static constexpr std::string_view kinds[] = {"fixed", "displacement", "velocity", "traction"};
-    const std::string group = bc.string("group");
+  // Checks the boundary's group against the mesh and imposes it.
+  void apply_boundary(const ContinuumBoundary& bc) {
+    const std::string& group = bc.group;
     if (!solver_->mesh().has_group(group)) {
       std::string known;
       for (const auto& g : solver_->mesh().groups()) known += (known.empty() ? "" : ", ") + g.name;
-      bc.fail("group", "the mesh has no physical group '" + group + "' (it has: " + known + ")");
+      bc.node.fail("group", "the mesh has no physical group '" + group + "' (it has: " + known + ")");
     }
-    const std::string kind = bc.choice("type", kinds);
-    if (kind == "traction") {
-      if (solver_->mesh().group(group).dim != 2) bc.fail("group", "a traction needs a surface group");
-      const Vec3 t = bc.vec3("value", Range::any(), "Pa");
-      solver_->add_traction(group, [t](const Vec3&, double) { return t; });
-      bc.finish();
+    if (bc.kind == "traction") {
+      if (solver_->mesh().group(group).dim != 2) bc.node.fail("group", "a traction needs a surface group");
+      solver_->add_traction(group, [t = bc.value](const Vec3&, double) { return t; });
       return;
     }
-    std::array<bool, 3> components{true, true, true};
-    if (bc.has("components")) {
-      components = {false, false, false};
-      for (const std::string& c : bc.strings("components")) {
-        if (c != "x" && c != "y" && c != "z") bc.fail("components", "expected a list of x, y, z, got '" + c + "'");
-        components[c[0] - 'x'] = true;
-      }
-    }
     continuum::VectorFunction g = [](const Vec3&, double) { return Vec3{}; };
-    if (kind == "displacement") {
-      const Vec3 u = bc.vec3("value", Range::any(), "m");
-      g = [u](const Vec3&, double) { return u; };
-    } else if (kind == "velocity") {
-      const Vec3 v = bc.vec3("value", Range::any(), "m/s");
-      const double rise = bc.number_or("rise", 0.0, Range::non_negative(), "s");
-      const double duration = bc.number_or("duration", INFINITY, Range::positive(), "s");
-      if (rise > duration) bc.fail("rise", "the rise time must not exceed the duration");
+    if (bc.kind == "displacement") {
+      g = [u = bc.value](const Vec3&, double) { return u; };
+    } else if (bc.kind == "velocity") {
       // Velocity v min(t / rise, 1) until `duration`, then held: g(t) is its integral.
-      const auto travel = [rise](double t) { return t < rise ? 0.5 * t * t / rise : t - 0.5 * rise; };
-      g = [v, duration, travel](const Vec3&, double t) { return v * travel(std::min(t, duration)); };
+      const auto travel = [rise = bc.rise](double t) { return t < rise ? 0.5 * t * t / rise : t - 0.5 * rise; };
+      g = [v = bc.value, duration = bc.duration, travel](const Vec3&, double t) { return v * travel(std::min(t, duration)); };
     }
-    bc.finish();
-    solver_->fix(group, components, g);
-    const auto dofs = coupling::group_dofs(*solver_, group, components);
+    solver_->fix(group, bc.components, g);
+    const auto dofs = coupling::group_dofs(*solver_, group, bc.components);
     held_dofs_.insert(held_dofs_.end(), dofs.begin(), dofs.end());
   }
 
-  std::unique_ptr<ContinuumSolver> solver_;
-  std::optional<coupling::OverlapZone> zone_;  // with a coupling section
-  std::optional<CaseNode> coupling_;          // the case's coupling section: where its errors are
-  coupling::CoupledOptions options_;
-  std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)
+  bool static_;
   std::string petsc_options_;
-  bool static_ = false;
+  std::unique_ptr<ContinuumSolver> solver_;
+  std::optional<CouplingCaseSettings> coupling_;  // with a coupling section
+  std::vector<int> held_dofs_;  // dofs with essential conditions (no coupling correction)
 };
 
 }  // namespace
@@ -397,7 +439,13 @@ std::span<const SchemaSection> ContinuumPart::schema() { return continuum_sectio
 
 std::unique_ptr<ContinuumPart> ContinuumPart::read(CaseNode section, std::optional<CaseNode> coupling,
                                                    const std::string& extra_petsc_options) {
-  return std::make_unique<Part>(section, coupling, extra_petsc_options);
+  ContinuumCaseSettings settings = read_continuum(section, extra_petsc_options);
+  std::optional<CouplingCaseSettings> coupled;
+  if (coupling) {
+    if (settings.is_static) coupling->fail("overlap", "a coupled continuum needs continuum.analysis: explicit");
+    coupled = read_coupling(*coupling);
+  }
+  return std::make_unique<Part>(std::move(settings), std::move(coupled));
 }
 
 }  // namespace arlequin::app

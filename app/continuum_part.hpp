@@ -1,7 +1,9 @@
 // The scene's continuum, read from the case file's `continuum:` section: the solver chosen by
 // name from the registry (fe, nem), its mesh, material, boundary conditions and analysis.
-// The one adapter between the application and continuum/: its header names no continuum type,
-// so scenes without a continuum never start PETSc or read a mesh.
+// The one adapter between the application and continuum/ and coupling/: its header names no
+// continuum type, so scenes without a continuum never start PETSc or read a mesh. The
+// sections are read into plain settings first (continuum_part.cpp: read_continuum,
+// read_coupling), then the solver and the coupling are built from them.
 //
 // Its keys (continuum:, coupling:) are declared beside their reader in continuum_part.cpp;
 // `arlequin schema continuum` and `arlequin schema coupling` print them.
