@@ -12,6 +12,7 @@
 #include "common/error.hpp"
 #include "common/json.hpp"
 #include "common/plots.hpp"
+#include "common/schema.hpp"
 
 namespace arlequin::app {
 
@@ -63,6 +64,60 @@ Json estimate_json(const Estimate& e) {
   return j;
 }
 Estimate read_estimate(const Json& j) { return {j.at("value").get<double>(), j.at("uncertainty").get<double>()}; }
+
+// ---- The keys of a calibration spec (common/schema.hpp) ---------------------------------
+
+constexpr KeyDoc spec_keys[] = {
+    {"case", KeyType::file, "", {}, "", "the case whose sample and bond section are calibrated"},
+    {"bond", KeyType::string, "", {}, "dem.bond", "key path of the calibrated bond section"},
+    {"r_mu", KeyType::numbers, "1", Range::positive(), "", "the grid of r_mu of the calibration curve (two or more)"},
+    {"axes", KeyType::strings, "", {}, "(z)", "tension axes averaged per curve point"},
+    {"tolerance", KeyType::number, "1", Range::positive(), "0.002", "relative tolerance on E_M and nu_M"},
+    {"verify", KeyType::list, "", {}, "(none)", "other samples the calibrated pairs are checked on"},
+    {"quasi_static", KeyType::section, "", {}, "(defaults)", "the tension tests' loading (quasi_static plan)"},
+    {"targets", KeyType::list, "", {}, "(none)", "materials (E_M, nu_M) to calibrate (E_mu, r_mu) for"},
+    {"failure", KeyType::section, "", {}, "(none)", "strengths (BBF sigma_f, RDEF thresholds) for failure stresses"},
+};
+constexpr KeyDoc verify_keys[] = {
+    {"name", KeyType::string, "", {}, "", "the sample's name"},
+    {"set", KeyType::strings, "", {}, "", "overrides of the case that make it"},
+};
+constexpr KeyDoc elastic_target_keys[] = {
+    {"name", KeyType::string, "", {}, "", "the material's name"},
+    {"E", KeyType::number, "Pa", Range::positive(), "", "target Young's modulus E_M"},
+    {"nu", KeyType::number, "1", Range::open_between(-1, 0.5), "", "target Poisson's ratio nu_M"},
+    {"reference", KeyType::section, "", {}, "(none)", "a published pair to print beside ours"},
+};
+constexpr KeyDoc reference_pair_keys[] = {
+    {"E_mu", KeyType::number, "Pa", Range::positive(), "", "published E_mu"},
+    {"r_mu", KeyType::number, "1", Range::positive(), "", "published r_mu"},
+};
+constexpr KeyDoc failure_spec_keys[] = {
+    {"axis", KeyType::string, "", {}, "(z)", "the tension axis of the tests to failure, x | y | z"},
+    {"tolerance", KeyType::number, "1", Range::open_between(0, 1), "0.02", "relative tolerance on the failure stress"},
+    {"test", KeyType::section, "", {}, "(defaults)", "the tests' loading (failure plan)"},
+    {"targets", KeyType::list, "", {}, "", "failure stresses to calibrate a strength for"},
+};
+constexpr KeyDoc failure_target_keys[] = {
+    {"name", KeyType::string, "", {}, "", "a material: an elastic target's name, or one given with its E, E_mu, r_mu"},
+    {"criterion", KeyType::choice, "", {}, "", "which strength is calibrated", "bbf | rdef"},
+    {"stress", KeyType::number, "Pa", Range::positive(), "", "target failure stress sigma_f of the material"},
+    {"E", KeyType::number, "(Pa)", Range::positive(), "(the elastic target's)", "Young's modulus, without an elastic target of this name"},
+    {"E_mu", KeyType::number, "(Pa)", Range::positive(), "(the elastic target's)", "its bonds' E_mu, likewise"},
+    {"r_mu", KeyType::number, "(1)", Range::positive(), "(the elastic target's)", "its bonds' r_mu, likewise"},
+    {"initial", KeyType::number, "Pa", Range::positive(), "(reference)", "first guess of the strength"},
+    {"reference", KeyType::number, "Pa", Range::positive(), "(none)", "published strength, printed beside ours"},
+    {"variant", KeyType::string, "", {}, "", "name of a variant of the criterion (names its folder)"},
+    {"set", KeyType::strings, "", {}, "(none)", "the variant's case options (key.path=value)"},
+};
+constexpr SchemaSection spec_sections[] = {
+    {"", "a calibration spec (arlequin calibrate)", spec_keys},
+    {"verify[]", "a verification sample", verify_keys},
+    {"targets[]", "an elastic target", elastic_target_keys},
+    {"targets[].reference", "a published pair", reference_pair_keys},
+    {"failure", "the failure calibration", failure_spec_keys},
+    {"failure.targets[]", "a failure target", failure_target_keys},
+};
 
 // The cache of curve points next to the sample: {"entries": [{"signature", "points": [...]}]}.
 class CurveCache {
@@ -243,8 +298,17 @@ void write_outputs(const CalibrationSpec& spec, const CalibrationResult& result,
 
 }  // namespace
 
+const Schema& calibration_schema() {
+  static const Schema schema = [] {
+    std::vector<SchemaSection> sections(std::begin(spec_sections), std::end(spec_sections));
+    for (const auto& s : plan_schema()) sections.push_back(s);
+    return Schema(std::move(sections));
+  }();
+  return schema;
+}
+
 CalibrationSpec CalibrationSpec::read(const std::filesystem::path& spec_file) {
-  CaseFile file = CaseFile::load(spec_file);
+  CaseFile file = CaseFile::load(spec_file, {}, &calibration_schema());
   CaseNode root = file.root();
   CalibrationSpec spec;
   spec.case_file = root.existing_file("case");

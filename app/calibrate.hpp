@@ -57,25 +57,12 @@ struct FailureTarget {
   std::string label() const { return variant.empty() ? criterion : criterion + "_" + variant; }
 };
 
-// Spec file (strict YAML; `arlequin calibrate SPEC.yaml`):
-//   case: sample.yaml        one-material case: a packing, density, a beam bond law with nu_mu
-//   bond: dem.bond           key path of the bond section whose E_mu and r_mu are calibrated
-//   r_mu: [0.15, 0.2, ...]   the grid of the curve
-//   axes: [x, y, z]          tension axes averaged per point (default [z])
-//   tolerance: 0.002         on nu_M for the refinement
-//   verify: [{name, set: ["key=value", ...]}]   further samples to verify the pairs on; give
-//                            each its own sample file (name= or dem.sample.file=), else its
-//                            packing replaces the calibration sample's cached one
-//   quasi_static: {...}      QuasiStatic (virtual_tests.hpp)
-//   targets: [{name, E [Pa], nu, reference: {E_mu [Pa], r_mu}}]   (optional with failure)
-//   failure:                 optional: strengths, after the elastic pairs
-//     axis: z                tension axis of the tests to failure
-//     tolerance: 0.02        relative, on the failure stress
-//     test: {...}            FailurePlan (virtual_tests.hpp); expected_strain = stress / E
-//     targets: [{name, criterion: bbf | rdef, stress [Pa], E [Pa], E_mu [Pa], r_mu, initial [Pa],
-//                reference [Pa], variant: name, set: ["key=value", ...]}]
-//                            variant + set: the same criterion with other case options (e.g.
-//                            dem.failure.rdef.average=bonded_neighbours), shown as rdef_<variant>
+// Spec file (strict YAML; `arlequin calibrate SPEC.yaml`): its keys are declared beside their
+// reader (calibration_schema(), calibrate.cpp) and printed by `arlequin schema --of calibrate`.
+// Give each verify sample its own sample file (name= or dem.sample.file=), else its packing
+// replaces the calibration sample's cached one. A failure target's variant + set run the same
+// criterion with other case options (e.g. dem.failure.rdef.average=bonded_neighbours), shown
+// as rdef_<variant>; a failure test's expected strain is the target stress / E.
 struct CalibrationSpec {
   std::filesystem::path case_file;
   std::string bond_key = "dem.bond";
@@ -150,5 +137,8 @@ struct CalibrationResult {
 // whose case has a BBF strength. InputError if a target's nu_M is outside the curve's range
 // (widen r_mu); RunError if a run stops.
 CalibrationResult calibrate(const CalibrationSpec& spec, const SceneOptions& options, const std::filesystem::path& out_dir);
+
+// The keys of a calibration spec (with the loading plans of virtual_tests.hpp).
+const Schema& calibration_schema();
 
 }  // namespace arlequin::app

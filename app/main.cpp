@@ -43,7 +43,9 @@ constexpr const char* usage_main =
     "                           and BBF / RDEF strengths to its tensile failure stress\n"
     "  compare A.yaml B.yaml    run two cases sharing sensors; B's difference to A against run time\n"
     "  laws                     list the bond and contact laws (dem.material.bond.law, dem.contact.law)\n"
-    "  schema [SECTION]         the case-file keys: type, unit, range, default, help (all, or one section)\n"
+    "  schema [SECTION] [--of case | virtual-test | calibrate]\n"
+    "                           the keys of a case file (or of a spec file): type, unit, range,\n"
+    "                           default, help; all, or the sections under SECTION\n"
     "\n"
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
@@ -108,6 +110,7 @@ struct Arguments {
   long steps = -1;
   std::vector<app::SweepAxis> axes;
   std::vector<std::string> samples;  // virtual-test --sample
+  std::string document = "case";     // schema --of
   bool quiet = false;
   bool help = false;
 };
@@ -148,6 +151,10 @@ Arguments parse(int argc, char** argv) {
       char* end = nullptr;
       a.steps = std::strtol(v.c_str(), &end, 10);
       if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+    } else if (arg == "--of" && a.command == "schema") {
+      a.document = value("case, virtual-test or calibrate");
+      if (a.document != "case" && a.document != "virtual-test" && a.document != "calibrate")
+        throw InputError("arlequin schema --of " + a.document + ": expected case, virtual-test or calibrate");
     } else if (arg == "--sample" && a.command == "virtual-test") {
       a.samples.push_back(value("a sample name"));
     } else if (arg == "--quiet" && a.command == "run") {
@@ -177,12 +184,16 @@ int list_laws() {
   return 0;
 }
 
-// The case-file schema, or the sections under one path ("dem", "coupling.overlap", "bond").
-int print_schema(const std::string& section) {
-  const std::string text = app::case_schema().describe(section);
+// A document's schema (a case file, a virtual-test or calibration spec), or its sections under
+// one path ("dem", "coupling.overlap", "bond").
+int print_schema(const std::string& document, const std::string& section) {
+  const Schema& schema = document == "virtual-test" ? app::virtual_test_schema()
+                         : document == "calibrate"  ? app::calibration_schema()
+                                                    : app::case_schema();
+  const std::string text = schema.describe(section);
   if (text.empty()) {
     std::vector<std::string_view> paths;
-    for (const auto& s : app::case_schema().sections()) paths.push_back(s.path);
+    for (const auto& s : schema.sections()) paths.push_back(s.path);
     const auto guess = closest_match(section, paths);
     throw InputError("arlequin schema: no section '" + section + "'" +
                      (guess ? "; did you mean '" + std::string(*guess) + "'?" : ""));
@@ -349,7 +360,7 @@ int main(int argc, char** argv) {
     if (a.command == "calibrate") return calibrate(a);
     if (a.command == "compare") return compare(a);
     if (a.command == "laws") return list_laws();
-    if (a.command == "schema") return print_schema(a.case_file);
+    if (a.command == "schema") return print_schema(a.document, a.case_file);
     return check(a);
   } catch (const InputError& e) {
     std::fprintf(stderr, "arlequin: error: %s\n", e.what());

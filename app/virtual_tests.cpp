@@ -14,6 +14,7 @@
 #include "app/text.hpp"
 #include "common/atomic_file.hpp"
 #include "common/case_file.hpp"
+#include "common/schema.hpp"
 #include "common/error.hpp"
 #include "common/json.hpp"
 
@@ -21,6 +22,100 @@ namespace arlequin::app {
 namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// ---- The keys of a virtual-test spec (common/schema.hpp) --------------------------------
+
+constexpr KeyDoc suite_keys[] = {
+    {"case", KeyType::file, "", {}, "", "the case whose sample is tested (its loads are replaced by the tests')"},
+    {"samples", KeyType::list, "", {}, "(one: the case's)", "samples to test, each the case with overrides"},
+    {"tests", KeyType::list, "", {}, "", "the load cases"},
+    {"quasi_static", KeyType::section, "", {}, "(defaults)", "how an elastic test loads (quasi_static plan)"},
+    {"failure", KeyType::section, "", {}, "(none)", "the tests go to failure, so loaded (failure plan)"},
+    {"composite", KeyType::section, "", {}, "(none)", "a UD composite's phases: the elastic suite's theory row"},
+};
+constexpr KeyDoc sample_variant_keys[] = {
+    {"name", KeyType::string, "", {}, "", "its folder name"},
+    {"set", KeyType::strings, "", {}, "[]", "overrides of the case (key.path=value)"},
+};
+constexpr KeyDoc load_case_keys[] = {
+    {"name", KeyType::string, "", {}, "", "its folder name"},
+    {"tension", KeyType::string, "", {}, "(none)", "the tension axis, x | y | z (or shear)"},
+    {"shear", KeyType::strings, "", {}, "(none)", "[face normal, direction] of a shear test"},
+    {"modulus_estimate", KeyType::number, "Pa", Range::positive(), "(none)", "expected modulus, to size the loading"},
+    {"set", KeyType::strings, "", {}, "[]", "overrides of the case for this test"},
+    {"reference", KeyType::section, "", {}, "(none)", "a test to failure: the published ranges it is judged against"},
+};
+constexpr KeyDoc failure_reference_keys[] = {
+    {"name", KeyType::string, "", {}, "", "where the ranges come from (e.g. seed Table 4 (#1-#3))"},
+    {"stress", KeyType::numbers, "Pa", Range::non_negative(), "", "failure stress range [low, high]"},
+    {"strain", KeyType::numbers, "1", Range::non_negative(), "", "failure strain range [low, high]"},
+    {"broken", KeyType::section, "", {}, "(none)", "broken-bond percentage range per bond set"},
+};
+constexpr KeyDoc broken_range_keys[] = {
+    {"<name>", KeyType::numbers, "%", Range::non_negative(), "", "[low, high] broken bonds of that set, %"},
+};
+constexpr KeyDoc composite_keys[] = {
+    {"fibre", KeyType::section, "", {}, "", "the fibre's isotropic constants"},
+    {"matrix", KeyType::section, "", {}, "", "the matrix's isotropic constants"},
+    {"fibre_fraction", KeyType::number, "1", Range::between(0, 1), "", "fibre volume fraction"},
+    {"references", KeyType::list, "", {}, "(none)", "published rows to print beside ours"},
+};
+constexpr KeyDoc phase_keys[] = {
+    {"E", KeyType::number, "Pa", Range::positive(), "", "Young's modulus"},
+    {"nu", KeyType::number, "1", Range::open_between(-1, 0.5), "", "Poisson's ratio"},
+};
+constexpr KeyDoc reference_row_keys[] = {
+    {"name", KeyType::string, "", {}, "", "the row's source"},
+    {"E_L", KeyType::number, "Pa", {}, "(none)", "longitudinal modulus"},
+    {"E_T", KeyType::number, "Pa", {}, "(none)", "transverse modulus"},
+    {"nu_LT", KeyType::number, "1", {}, "(none)", "Poisson's ratio, axial load"},
+    {"nu_TT", KeyType::number, "1", {}, "(none)", "Poisson's ratio in the transverse plane"},
+    {"G_LT", KeyType::number, "Pa", {}, "(none)", "axial shear modulus"},
+    {"G_TT", KeyType::number, "Pa", {}, "(none)", "transverse shear modulus"},
+};
+constexpr KeyDoc quasi_static_keys[] = {
+    {"strain", KeyType::number, "1", Range::open_between(0, 0.05), "2e-04", "final normal strain (tension) or shear angle"},
+    {"ramp", KeyType::number, "transit times", Range::positive(), "3", "time over which the strain is applied"},
+    {"plateau", KeyType::number, "transit times", Range::positive(), "3", "time it is held"},
+    {"damping", KeyType::number, "1", Range::non_negative(), "0.5", "fraction of the fundamental mode's critical damping"},
+    {"average", KeyType::number, "1", Range::open_between(0, 1), "0.5", "the last fraction of the plateau averaged"},
+    {"rows_per_transit", KeyType::number, "1", Range::at_least(2), "20", "series rows per transit time"},
+};
+constexpr KeyDoc failure_plan_keys[] = {
+    {"expected_strain", KeyType::number, "1", Range::open_between(0, 0.5), "0.01", "expected failure strain, sizes the pull"},
+    {"transits", KeyType::number, "transit times", Range::positive(), "25", "time to reach the expected strain"},
+    {"max_strain_factor", KeyType::number, "1", Range::at_least(1), "2", "the run ends at this multiple of it"},
+    {"stop_below", KeyType::number, "1", Range::open_between(0, 1), "0.5", "stop once the stress falls below this fraction of its peak"},
+    {"stop_after", KeyType::number, "transit times", Range::non_negative(), "0", "... and this long after the peak"},
+    {"damping", KeyType::number, "1", Range::non_negative(), "0.05", "fraction of the fundamental mode's critical damping"},
+    {"rise", KeyType::number, "transit times", Range::non_negative(), "1", "time over which the pull speed rises"},
+    {"rows_per_transit", KeyType::number, "1", Range::at_least(2), "20", "series rows per transit time"},
+    {"frames", KeyType::number, "1", Range::between(0, 10000), "0", "field frames over the run (particles, bonds)"},
+};
+constexpr SchemaSection plan_sections[] = {
+    {"quasi_static plan", "an elastic test's loading (quasi_static:)", quasi_static_keys},
+    {"failure plan", "a test to failure's loading (failure: of a suite, failure.test: of a calibration)", failure_plan_keys},
+};
+constexpr SchemaSection suite_sections[] = {
+    {"", "a virtual-test spec (arlequin virtual-test)", suite_keys},
+    {"samples[]", "a sample variant", sample_variant_keys},
+    {"tests[]", "a load case", load_case_keys},
+    {"tests[].reference", "published failure ranges", failure_reference_keys},
+    {"tests[].reference.broken", "broken-bond ranges by bond set", broken_range_keys},
+    {"composite", "a UD composite", composite_keys},
+    {"composite.fibre", "fibre", phase_keys},
+    {"composite.matrix", "matrix", phase_keys},
+    {"composite.references[]", "a published row", reference_row_keys},
+};
+
+const Schema& suite_schema() {
+  static const Schema schema = [] {
+    std::vector<SchemaSection> sections(std::begin(suite_sections), std::end(suite_sections));
+    sections.insert(sections.end(), std::begin(plan_sections), std::end(plan_sections));
+    return Schema(std::move(sections));
+  }();
+  return schema;
+}
 
 // The shortest text that reads back as the same double.
 std::string shortest(double value) {
@@ -396,6 +491,9 @@ void require_new_name(const CaseNode& node, const std::vector<Named>& items, con
 
 }  // namespace
 
+std::span<const SchemaSection> plan_schema() { return plan_sections; }
+const Schema& virtual_test_schema() { return suite_schema(); }
+
 std::string LoadCase::describe() const {
   return shear() ? "shear of the " + std::string(axis_names[face]) + " faces along " + std::string(axis_names[direction])
                  : "tension along " + std::string(axis_names[face]);
@@ -424,6 +522,7 @@ LoadCase LoadCase::read(CaseNode& node) {
 QuasiStatic QuasiStatic::read(std::optional<CaseNode> node) {
   QuasiStatic q;
   if (!node) return q;
+  node->add_schema_section("quasi_static plan");
   q.strain = node->number_or("strain", q.strain, Range::open_between(0.0, 0.05), "1");
   q.ramp = node->number_or("ramp", q.ramp, Range::positive(), "transit times");
   q.plateau = node->number_or("plateau", q.plateau, Range::positive(), "transit times");
@@ -585,6 +684,7 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
 FailurePlan FailurePlan::read(std::optional<CaseNode> node) {
   FailurePlan f;
   if (!node) return f;
+  node->add_schema_section("failure plan");
   f.expected_strain = node->number_or("expected_strain", f.expected_strain, Range::open_between(0.0, 0.5), "1");
   f.transits = node->number_or("transits", f.transits, Range::positive(), "transit times");
   f.max_strain_factor = node->number_or("max_strain_factor", f.max_strain_factor, Range::at_least(1.0), "1");
@@ -898,12 +998,26 @@ int run_failure_suite(const std::filesystem::path& case_file, const SceneOptions
 
 }  // namespace
 
-int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
-                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples) {
-  CaseFile file = CaseFile::load(spec_file);
-  CaseNode root = file.root();
-  const std::filesystem::path case_file = root.existing_file("case");
+namespace {
+
+// A virtual-test spec as read (its keys: virtual_test_schema()).
+struct SuiteSpec {
+  std::filesystem::path case_file;
   std::vector<SampleVariant> samples;
+  QuasiStatic plan;
+  std::vector<LoadCase> tests;
+  std::vector<std::optional<FailureReference>> references;  // with a failure plan, one per test
+  std::optional<FailurePlan> failure;
+  std::optional<CompositeSpec> composite;
+  std::optional<CompositeTests> roles;
+};
+
+SuiteSpec read_suite(const std::filesystem::path& spec_file) {
+  CaseFile file = CaseFile::load(spec_file, {}, &suite_schema());
+  CaseNode root = file.root();
+  SuiteSpec spec;
+  spec.case_file = root.existing_file("case");
+  std::vector<SampleVariant>& samples = spec.samples;
   for (CaseNode s : root.list_or_empty("samples")) {
     const std::string name = folder_name(s);
     samples.push_back({name, s.overrides_or_empty("set")});
@@ -911,6 +1025,47 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
     s.finish();
   }
   if (samples.empty()) samples.push_back({"base", {}});
+  spec.plan = QuasiStatic::read(root.child_if("quasi_static"));
+  const std::optional<CaseNode> failure_node = root.child_if("failure");
+  std::vector<LoadCase>& tests = spec.tests;
+  for (CaseNode t : root.list("tests")) {
+    tests.push_back(LoadCase::read(t));
+    require_new_name(t, tests, "test");
+    if (failure_node) {
+      if (tests.back().shear()) t.fail("shear", "a test to failure (failure section) is a tension test");
+      spec.references.push_back(FailureReference::read(t.child_if("reference")));
+    }
+    t.finish();
+  }
+  if (failure_node) {
+    if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
+    spec.failure = FailurePlan::read(failure_node);
+  } else if (auto node = root.child_if("composite")) {
+    spec.composite = CompositeSpec::read(*node);
+    spec.roles = CompositeTests::find(root, tests);
+    const Constants theory = spec.composite->theory();
+    for (std::size_t i = 0; i < tests.size(); ++i)
+      if (!tests[i].modulus_estimate) tests[i].modulus_estimate = spec.roles->estimate(i, theory);
+  }
+  root.finish();
+  return spec;
+}
+
+}  // namespace
+
+void validate_virtual_test_spec(const std::filesystem::path& spec_file) { read_suite(spec_file); }
+
+int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
+                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples) {
+  SuiteSpec spec = read_suite(spec_file);
+  const std::filesystem::path& case_file = spec.case_file;
+  const std::vector<SampleVariant>& samples = spec.samples;
+  const QuasiStatic& plan = spec.plan;
+  std::vector<LoadCase>& tests = spec.tests;
+  const auto& references = spec.references;
+  const auto& failure = spec.failure;
+  const auto& composite = spec.composite;
+  const auto& roles = spec.roles;
   std::vector<std::string_view> sample_names;
   std::string listed;
   for (const SampleVariant& s : samples) {
@@ -923,33 +1078,6 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
       throw InputError(spec_file.string() + ": --sample " + name + ": no sample of that name" +
                        (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; samples: " + listed));
     }
-  const QuasiStatic plan = QuasiStatic::read(root.child_if("quasi_static"));
-  const std::optional<CaseNode> failure_node = root.child_if("failure");
-  std::vector<LoadCase> tests;
-  std::vector<std::optional<FailureReference>> references;
-  for (CaseNode t : root.list("tests")) {
-    tests.push_back(LoadCase::read(t));
-    require_new_name(t, tests, "test");
-    if (failure_node) {
-      if (tests.back().shear()) t.fail("shear", "a test to failure (failure section) is a tension test");
-      references.push_back(FailureReference::read(t.child_if("reference")));
-    }
-    t.finish();
-  }
-  std::optional<FailurePlan> failure;
-  std::optional<CompositeSpec> composite;
-  std::optional<CompositeTests> roles;
-  if (failure_node) {
-    if (root.has("composite")) root.fail("composite", "a failure suite has no composite table; run the elastic suite for it");
-    failure = FailurePlan::read(failure_node);
-  } else if (auto node = root.child_if("composite")) {
-    composite = CompositeSpec::read(*node);
-    roles = CompositeTests::find(root, tests);
-    const Constants theory = composite->theory();
-    for (std::size_t i = 0; i < tests.size(); ++i)
-      if (!tests[i].modulus_estimate) tests[i].modulus_estimate = roles->estimate(i, theory);
-  }
-  root.finish();
   check_every_test(case_file, options, samples, only_samples, tests, failure.has_value(), references);
   if (failure) return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, *failure);
 

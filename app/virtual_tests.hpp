@@ -3,7 +3,7 @@
 // docs/validation.md R2, R3), and the suites of them that `arlequin virtual-test` runs.
 //
 // A test is the sample case (dem sample, materials or bond law; no groups, boundary or sensors
-// of its own) plus generated sections (`--set` overrides):
+// of its own) plus generated sections (overrides built as data, CaseValue):
 //  - groups: one slab per loaded or gauged face, one mean DE diameter thick, from the DEs'
 //    bounding box (the DEs whose centre lies in it);
 //  - tension along axis a: the lower a-face held in component a only, the upper a-face moved
@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "app/scene.hpp"
+#include "common/schema.hpp"
 
 namespace arlequin {
 class CaseNode;
@@ -81,7 +82,7 @@ struct QuasiStatic {
   double average = 0.5;    // the last fraction of the plateau that is averaged
   double rows_per_transit = 20.0;
 
-  // Reads an optional mapping {strain, ramp, plateau, damping, average, rows_per_transit}.
+  // Reads an optional mapping (its keys: the schema section "quasi_static plan").
   static QuasiStatic read(std::optional<CaseNode> node);
   std::string describe() const;  // one line, for reports and cache keys (every field, exactly)
 };
@@ -182,25 +183,15 @@ FailureTestResult run_failure_test(const std::filesystem::path& case_file, const
 VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const SceneOptions& options,
                                    const LoadCase& load, const QuasiStatic& plan);
 
-// `arlequin virtual-test SPEC.yaml`: a suite of tests on one or more samples. Spec (strict):
-//   case: case.yaml                  the sample case (relative to the spec file)
-//   samples: [{name, set: ["key=value", ...]}]   variants of the case (default: one, "base")
-//   quasi_static: {...}              QuasiStatic
-//   tests: [{name, tension: z | shear: [z, x], modulus_estimate, set: ["key=value", ...]}]
-//   failure: {...}                   optional FailurePlan: every test (tension only) runs to
-//                                    failure instead; each test may carry
-//     reference: {name, stress: [lo, hi] Pa, strain: [lo, hi], broken: {<bond set>: [lo, hi] %}}
-//                                    (e.g. the range of seed Table 4) for the table
-//                                    out_dir/failure.md; out_dir/failure.csv has every run
-//   composite:                       optional: a unidirectional composite whose tests are named
-//     fibre: {E, nu}, matrix: {E, nu}, fibre_fraction     L (tension along the fibres), T
-//     references: [{name, E_L, E_T, nu_LT, nu_TT, G_LT, G_TT}]  (tension across), LT (shear
-//                                    in the L-T plane), TT (shear in the T-T' plane, for
-//                                    G_TT'); its engineering constants are tabulated next to the
-//                                    closed forms (app/micromechanics.hpp) and the references,
-//                                    whose missing entries are left blank; tests without a
-//                                    modulus_estimate take the closed form's (E_T for L and T,
-//                                    G_LT, G_TT': the slowest motion of each test).
+// `arlequin virtual-test SPEC.yaml`: a suite of tests on one or more samples. The spec's keys are
+// declared beside their reader (virtual_test_schema(), virtual_tests.cpp) and printed by
+// `arlequin schema --of virtual-test`. With failure:, every test (tension only) runs to failure
+// and its reference ranges (e.g. seed Table 4) fill out_dir/failure.md (failure.csv has every
+// run). With composite:, the tests are named L (tension along the fibres), T (across), LT
+// (shear in the L-T plane) and TT (shear in the T-T' plane, for G_TT'); their engineering
+// constants are tabulated next to the closed forms (app/micromechanics.hpp) and the
+// references, whose missing entries are left blank; tests without a modulus_estimate take the
+// closed form's (E_T for L and T, G_LT, G_TT': the slowest motion of each test).
 // Reads the case of every sample (or only those named in only_samples) x test first, so that a
 // bad override or a reference to a bond set the case lacks is an InputError before any run;
 // then runs each into out_dir/<sample>/<test>/, prints one line per test and the tables, and writes out_dir/tests.csv and (with composite)
@@ -208,5 +199,13 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
 // number of runs that stopped (0: all measured).
 int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
                            const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples = {});
+
+// Reads a virtual-test spec as run_virtual_test_suite does, without building a scene; InputError
+// at the key.
+void validate_virtual_test_spec(const std::filesystem::path& spec_file);
+// The keys of a virtual-test spec, and those of the two loading plans that calibration specs
+// share (sections "quasi_static plan", "failure plan").
+const Schema& virtual_test_schema();
+std::span<const SchemaSection> plan_schema();
 
 }  // namespace arlequin::app

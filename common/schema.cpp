@@ -48,7 +48,9 @@ std::string Schema::describe(std::string_view prefix) const {
       if (k.type == KeyType::choice) type = std::string(k.values);
       const std::string range = k.range.describe();
       if (!range.empty()) type += " " + range;
-      if (!k.unit.empty() && k.unit != "1") type += " [" + std::string(k.unit) + "]";
+      std::string_view unit = k.unit;  // "(...)": a unit the reader states per case; shown without the marks
+      if (unit.starts_with("(") && unit.ends_with(")")) unit = unit.substr(1, unit.size() - 2);
+      if (!unit.empty() && unit != "1") type.append(" [").append(unit).append("]");
       std::string line = "  " + std::string(k.key);
       line.resize(std::max<std::size_t>(line.size() + 1, 22), ' ');
       line += type;

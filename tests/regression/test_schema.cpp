@@ -5,10 +5,13 @@
 // take the readers through their other branches).
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "app/calibrate.hpp"
 #include "app/case_schema.hpp"
+#include "app/virtual_tests.hpp"
 #include "app/scene.hpp"
 #include "common/error.hpp"
 #include "support/cli.hpp"
@@ -32,6 +35,16 @@ void read_case(const std::string& file, std::vector<Override> overrides, const s
     app::build_scene(file, options);
   } catch (const InputError&) {
   }
+}
+
+// The names of the keys `schema` declares that no read has asked for ("section: key" lines).
+std::string unread_keys(const Schema& schema) {
+  std::string unread;
+  for (const SchemaSection& section : schema.sections())
+    for (const KeyDoc& key : section.keys)
+      if (!schema.read().contains(std::string(section.path) + "|" + std::string(key.key)))
+        unread += "\n  " + std::string(section.path) + ": " + std::string(key.key);
+  return unread;
 }
 
 TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
@@ -73,13 +86,40 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
   read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
   read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
 
-  const Schema& schema = app::case_schema();
-  std::string unread;
-  for (const SchemaSection& section : schema.sections())
-    for (const KeyDoc& key : section.keys)
-      if (!schema.read().contains(std::string(section.path) + "|" + std::string(key.key)))
-        unread += "\n  " + std::string(section.path) + ": " + std::string(key.key);
-  EXPECT_TRUE(unread.empty()) << "declared but never read:" << unread;
+  EXPECT_TRUE(unread_keys(app::case_schema()).empty()) << "declared but never read:" << unread_keys(app::case_schema());
+}
+
+// The same for the spec files of `arlequin virtual-test` and `arlequin calibrate`: the shipped
+// specs, and one of each that takes the readers through their other branches (read only: no
+// test or calibration runs).
+TEST_F(SchemaTest, EveryDeclaredSpecKeyIsReadByItsReader) {
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return dir_ / name;
+  };
+  const std::string rev_case = cases + "rev_elastic/case.yaml";
+  for (const char* spec : {"rev_elastic/virtual_tests.yaml", "rev_failure/failure_tests.yaml"}) app::validate_virtual_test_spec(cases + spec);
+  app::validate_virtual_test_spec(write("elastic.yaml", "case: " + rev_case + "\n"
+      "samples: [{name: a, set: [dem.sample.seed=8]}]\n"
+      "quasi_static: {strain: 1.0e-4, ramp: 2, plateau: 2, damping: 0.4, average: 0.4, rows_per_transit: 10}\n"
+      "composite:\n  fibre: {E: 2.6e11, nu: 0.3}\n  matrix: {E: 3.45e9, nu: 0.35}\n  fibre_fraction: 0.5\n"
+      "  references: [{name: r, E_L: 1.0e11, E_T: 1.0e10, nu_LT: 0.3, nu_TT: 0.4, G_LT: 5.0e9, G_TT: 3.0e9}]\n"
+      "tests:\n  - {name: L, tension: z, modulus_estimate: 1.0e11}\n  - {name: T, tension: x}\n"
+      "  - {name: LT, shear: [x, z]}\n  - {name: TT, shear: [x, y]}\n"));
+  const Schema& suite = app::virtual_test_schema();
+  EXPECT_TRUE(unread_keys(suite).empty()) << "declared but never read:" << unread_keys(suite);
+
+  for (const char* spec : {"rev_elastic/calibration.yaml", "rev_failure/calibration.yaml", "rev_failure/calibration_laguerre.yaml"})
+    app::CalibrationSpec::read(cases + spec);
+  app::CalibrationSpec::read(write("calibration.yaml", "case: " + rev_case + "\nbond: dem.materials.matrix.bond\n"
+      "r_mu: [0.2, 0.3]\naxes: [x, z]\ntolerance: 0.01\nverify: [{name: v, set: [dem.sample.seed=8]}]\n"
+      "quasi_static: {strain: 1.0e-4}\n"
+      "targets: [{name: epoxy, E: 3.45e9, nu: 0.35, reference: {E_mu: 1.0e11, r_mu: 0.3}}]\n"
+      "failure: {axis: z, tolerance: 0.05, test: {transits: 10},\n"
+      "  targets: [{name: epoxy, criterion: rdef, stress: 7.0e7, initial: 1.0e8, variant: v, set: [dem.failure.rdef.average=none]},\n"
+      "            {name: other, criterion: bbf, stress: 7.0e7, E: 3.0e9, E_mu: 1.0e11, r_mu: 0.3, reference: 2.0e9}]}\n"));
+  const Schema& calibration = app::calibration_schema();
+  EXPECT_TRUE(unread_keys(calibration).empty()) << "declared but never read:" << unread_keys(calibration);
 }
 
 // `arlequin schema` prints every section from the one table; a section on request; an unknown
