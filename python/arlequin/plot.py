@@ -125,11 +125,11 @@ def figure(results_dir, plot, tables=None):
     log_x = plot.get("log_x", False)
     # Scales are set before plotting, so that a log axis left with no data still draws.
     if log_x:
-        left.set_xscale("log")
+        _log_scale(left.xaxis, left.set_xscale)
     if plot.get("log_y", False):
-        left.set_yscale("log")
+        _log_scale(left.yaxis, left.set_yscale)
     if right is not None and plot.get("log_y2", False):
-        right.set_yscale("log")
+        _log_scale(right.yaxis, right.set_yscale)
     colours = rcParams["axes.prop_cycle"].by_key()["color"]
     handles = []
     for j, series in enumerate(plot["series"]):
@@ -204,6 +204,15 @@ def _numbers(cells, file, column, name):
         return np.array([float(c) if c.strip() else math.nan for c in cells], dtype=float)
     except ValueError as e:
         raise PlotError(f'{name}: column "{column}" of {file} is not numeric ({e})') from None
+
+
+def _log_scale(axis, set_scale):
+    """A log scale whose minor ticks are labelled too over spans of up to two decades, where the
+    decades alone would leave one or two numbers on the axis."""
+    from matplotlib.ticker import LogFormatterSciNotation
+
+    set_scale("log")
+    axis.set_minor_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
 
 
 def _drop_unplottable(x, y, log_x, log_y):

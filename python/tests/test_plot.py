@@ -75,6 +75,17 @@ def test_log_axes_skip_non_positive_values(results):
     np.testing.assert_array_equal(y2, [NAN, NAN, NAN, 2, 4])
 
 
+def test_a_log_axis_within_two_decades_labels_more_than_its_decades(results):
+    # 0.015 .. 0.13 holds one power of ten: without labelled minor ticks the axis shows one number.
+    spec = {"file": "a.png", "log_y": True, "series": [{"x_values": [1, 2, 3], "y_values": [0.13, 0.045, 0.015]}]}
+    fig = plot.figure(results.path, spec)
+    fig.canvas.draw()
+    axis = fig.axes[0].yaxis
+    labels = [t.get_text() for t in axis.get_majorticklabels() + axis.get_minorticklabels()
+              if t.get_text() and 0.015 <= t.get_position()[1] <= 0.13]
+    assert len(labels) >= 4, labels
+
+
 def test_log_axes_without_plottable_data_still_draw(results, tmp_path):
     spec = {"file": "a.png", "log_x": True, "log_y": True, "log_y2": True, "series": [
         {"x_values": [0, -1], "y_values": [1, 2]}, csv_series("broken", y_scale=-1, right_axis=True)]}
