@@ -129,9 +129,11 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   Prepared prepared_b = prepare(other_case, base, out_dir / "other");
   // Shared sensor columns (the energy totals mean different things for a DEM and a coupled run).
   const std::vector<std::string> sensors_a = sensor_columns(*prepared_a.scene), sensors_b = sensor_columns(*prepared_b.scene);
-  std::vector<std::string> shared;
-  for (const std::string& name : sensors_a)
-    if (std::find(sensors_b.begin(), sensors_b.end(), name) != sensors_b.end()) shared.push_back(name);
+  const std::vector<std::string> units_a = sensor_units(*prepared_a.scene);
+  std::vector<std::string> shared, shared_units;
+  for (std::size_t k = 0; k < sensors_a.size(); ++k)
+    if (std::find(sensors_b.begin(), sensors_b.end(), sensors_a[k]) != sensors_b.end())
+      shared.push_back(sensors_a[k]), shared_units.push_back(units_a[k]);
   if (shared.empty())
     throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
   const Run a = execute(prepared_a, out_dir / "reference");
@@ -143,7 +145,8 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   std::string csv = "sensor,max_relative_difference,rms_relative_difference\n";
   std::vector<Plot> plots;
   std::printf("| sensor | max rel. difference | RMS rel. difference |\n|---|---|---|\n");
-  for (const std::string& name : shared) {
+  for (std::size_t s = 0; s < shared.size(); ++s) {
+    const std::string& name = shared[s];
     const auto va = a.column(name), vb = resample(tb, b.column(name), ta);
     double max_diff = 0, max_ref = 0, sum_diff = 0, sum_ref = 0;
     for (std::size_t k = 0; k < va.size(); ++k) {
@@ -167,7 +170,7 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
     plot.file = "compare_" + name + ".png";
     plot.title = name + ": " + b.name + " against " + a.name;
     plot.x_label = "time [s]";
-    plot.y_label = name;
+    plot.y_label = shared_units[s] == "1" ? name : name + " [" + shared_units[s] + "]";
     plot.curves.resize(2);
     plot.curves[0].label = a.name, plot.curves[0].x = ta, plot.curves[0].y = va;
     plot.curves[1].label = b.name, plot.curves[1].x = tb, plot.curves[1].y = b.column(name);

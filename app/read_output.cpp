@@ -255,5 +255,17 @@ std::vector<std::string> sensor_columns(const Scene& scene) {
   return out;
 }
 
+std::vector<std::string> sensor_units(const Scene& scene) {
+  std::vector<std::string> out;
+  for (const Sensor& s : scene.sensors) {
+    const char* unit = s.kind == Sensor::Kind::force          ? "N"
+                       : s.kind == Sensor::Kind::displacement ? "m"
+                       : s.kind == Sensor::Kind::velocity     ? "m/s"
+                       : s.kind == Sensor::Kind::energy       ? "J"
+                                                              : "1";
+    out.insert(out.end(), s.component >= 0 ? 1 : 3, unit);
+  }
+  return out;
+}
 
 }  // namespace arlequin::app

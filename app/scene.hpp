@@ -100,6 +100,8 @@ struct SceneOptions {
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).
 std::vector<std::string> sensor_columns(const Scene& scene);
+// The unit of each of those columns: N, m, m/s, J, or 1 (affine deviation).
+std::vector<std::string> sensor_units(const Scene& scene);
 
 // The schema of the sections that build_scene reads itself (app/case_schema.cpp adds the rest).
 std::span<const SchemaSection> scene_schema();

@@ -488,6 +488,10 @@ TEST(Cli, CompareReportsErrorAndSpeedUp) {
   EXPECT_EQ(sensors[0].at("sensor").get<std::string>(), "E_dem_side");
   EXPECT_LT(sensors[1].at("rms_relative_difference").get<double>(), 0.2);  // u_probe
   EXPECT_TRUE(std::filesystem::exists(out / "compare_u_probe.png"));
+  const Json plots = read_json_file(out / "plots.json").at("plots");  // each sensor's plot, in its unit
+  ASSERT_EQ(plots.size(), 2u);
+  EXPECT_EQ(plots.at(0).at("y_label").get<std::string>(), "E_dem_side [J]");
+  EXPECT_EQ(plots.at(1).at("y_label").get<std::string>(), "u_probe [m]");
   EXPECT_TRUE(std::filesystem::exists(out / "compare.csv"));
 }
 
