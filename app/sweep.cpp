@@ -97,10 +97,19 @@ std::pair<std::string, std::string> format_header(const std::vector<SweepAxis>& 
   return {md + "\n" + rule, csv};
 }
 
+// A CSV field: quoted (RFC 4180, quotes doubled) when it holds a comma, a quote or a line break,
+// as a swept box or vector does.
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string out = "\"";
+  for (const char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
 // One Markdown line and one CSV row; a run that never got to its checks shows "-" there.
 std::pair<std::string, std::string> format_row(const SweepRow& row, std::size_t num_checks) {
   std::string line = "|", csv;
-  for (const auto& v : row.picked) line += " " + v + " |", csv += v + ",";
+  for (const auto& v : row.picked) line += " " + v + " |", csv += csv_field(v) + ",";
   char buffer[256];
   std::snprintf(buffer, sizeof buffer, " %zu | %ld | %ld |", row.particles, row.nodes, row.steps);
   line += buffer;
@@ -117,8 +126,8 @@ std::pair<std::string, std::string> format_row(const SweepRow& row, std::size_t 
   }
   std::snprintf(buffer, sizeof buffer, " %.3f | %s |", row.wall, row.status.c_str());
   line += buffer;
-  std::snprintf(buffer, sizeof buffer, "%.6f,%s", row.wall, row.status.c_str());
-  csv += buffer;
+  std::snprintf(buffer, sizeof buffer, "%.6f,", row.wall);
+  csv += buffer + csv_field(row.status);
   return {line, csv};
 }
 

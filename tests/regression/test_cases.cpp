@@ -5,6 +5,7 @@
 #include <csignal>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <type_traits>
 #include <vector>
 
@@ -200,6 +201,33 @@ TEST(Cli, SweepTabulatesErrorAgainstRunTime) {
             std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
   EXPECT_TRUE(std::filesystem::exists(out / "sweep.png"));
+}
+
+// A swept box is one field of sweep.csv: quoted, so every row has the header's columns.
+TEST(Cli, SweepCsvQuotesValuesWithCommas) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("sweep_boxes");
+  const std::string boxes = "[[0.044,-0.001,-0.001],[0.052,0.009,0.009]],[[0.044,-0.001,-0.001],[0.060,0.009,0.009]]";
+  const auto r = test::run_arlequin("sweep " + cases + "wave_bar_coupled/case.yaml --set output.fields=[] --set checks=[] --set time.end=2e-5 --over \"coupling.overlap.box=" +
+                                        boxes + "\" --out " + out.string(), "stdout");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  std::istringstream csv(test::read_text(out / "sweep.csv"));
+  const auto fields = [](const std::string& line) {  // commas outside quotes, plus one
+    std::size_t n = 1;
+    bool quoted = false;
+    for (const char c : line) quoted = c == '"' ? !quoted : quoted, n += c == ',' && !quoted;
+    return n;
+  };
+  std::string header, row;
+  std::getline(csv, header);
+  int rows = 0;
+  for (; std::getline(csv, row); ++rows) {
+    EXPECT_EQ(fields(row), fields(header)) << row;
+    EXPECT_EQ(row.rfind("\"[[0.044,-0.001,-0.001],[0.0", 0), 0u) << row;
+  }
+  EXPECT_EQ(rows, 2);
 }
 
 // Sweep values split at commas outside brackets, so a box or a vector can be swept.
