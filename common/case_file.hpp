@@ -1,8 +1,9 @@
 // Case files: the user's YAML description of a simulation, read through a strict schema.
 //
-// Readers pull values through CaseNode accessors that state the type, allowed range and
-// unit of each key, so the schema lives next to the code that uses it. Every accessor
-// records the key as known; finish() then rejects any key the reader never asked for,
+// Readers pull values through CaseNode accessors that state the type, allowed range and unit
+// of each key; loaded with a Schema (common/schema.hpp), every read is checked against the
+// key's declaration beside its reader, so the printed schema is the one the code reads. Every
+// accessor records the key as known; finish() then rejects any key the reader never asked for,
 // which catches typos that would otherwise silently fall back to defaults. Every error is
 // one line naming where (file:line, or the --set text that provided the value), the key
 // path and what was expected. Everything read, defaults included, is mirrored into a
