@@ -302,9 +302,12 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
   const auto write_outputs = [&] {
     const auto t0 = Clock::now();
-    const SceneEnergies energies = scene.model->energies();
+    // A row takes every model's energies (the continuum's strain energy is a pass over it); a
+    // frame alone needs only the DEM's, for the summary.
+    const bool row = current_time() + slack >= next_row || steps_done == total_steps;
+    const SceneEnergies energies = row ? scene.model->energies() : SceneEnergies{model.energies()};
     result.energies = energies.dem;
-    if (current_time() + slack >= next_row || steps_done == total_steps) {
+    if (row) {
       result.sensors = outputs.write_row(current_time(), steps_done, energies, initial_total);
       next_row += scene.output.every;
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);

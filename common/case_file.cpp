@@ -135,16 +135,9 @@ std::string describe(const YAML::Node& n) {
   return "'" + s + "'";
 }
 
-std::string joined(const auto& words) {
+std::string joined(const auto& words, std::string_view separator = ", ") {
   std::string out;
-  for (const auto& w : words) (out += out.empty() ? "" : ", ") += w;
-  return out;
-}
-
-// "a | b | c": the allowed words of a choice, as the schema writes them.
-std::string choice_text(std::span<const std::string_view> allowed) {
-  std::string out;
-  for (const auto& w : allowed) (out += out.empty() ? "" : " | ") += w;
+  for (const auto& w : words) (out += out.empty() ? "" : separator) += w;
   return out;
 }
 
@@ -559,7 +552,7 @@ std::string CaseNode::string_or(std::string_view key, std::string_view fallback)
 }
 
 std::string CaseNode::choice(std::string_view key, std::span<const std::string_view> allowed) {
-  check_schema(key, KeyType::choice, nullptr, {}, nullptr, choice_text(allowed));
+  check_schema(key, KeyType::choice, nullptr, {}, nullptr, joined(allowed, " | "));
   const std::string expected = "one of " + joined(allowed);
   const Entry e = lookup(key);
   if (!e.present()) missing(key, expected);
@@ -578,7 +571,7 @@ std::string CaseNode::choice(std::string_view key, std::span<const std::string_v
 std::string CaseNode::choice_or(std::string_view key, std::string_view fallback,
                                 std::span<const std::string_view> allowed) {
   const std::string fallback_text(fallback);
-  check_schema(key, KeyType::choice, nullptr, {}, &fallback_text, choice_text(allowed));
+  check_schema(key, KeyType::choice, nullptr, {}, &fallback_text, joined(allowed, " | "));
   if (!find(key).present()) {
     lookup(key);
     record_->put(key, Kind::Text, std::string(fallback));
