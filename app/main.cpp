@@ -214,9 +214,11 @@ void print_scene_facts(const app::Scene& scene) {
                 scene.sample_file.string().c_str(), r.compaction, r.mean_coordination, r.interior_coordination,
                 r.fabric_eigenvalues[0], r.fabric_eigenvalues[1], r.fabric_eigenvalues[2], r.max_overlap, r.seconds);
   }
-  for (const auto& set : model.bond_sets())
+  for (const auto& set : model.bond_sets()) {
     std::printf("  %s (%s): %zu\n", set->name == "bonds" ? "bonds" : (set->name + " bonds").c_str(), std::string(set->law()).c_str(),
                 set->size());
+    if (const std::string more = set->describe(); !more.empty()) std::printf("    %s\n", more.c_str());
+  }
   if (model.particles.size() > 0)
     std::printf("  contact: %s\n", model.has_contact() ? "on" : "off (no contact search)");
   if (scene.continuum) {

@@ -2,6 +2,7 @@
 #include "app/scene_readers.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -58,7 +59,7 @@ constexpr KeyDoc particle_keys[] = {
     {"velocity", KeyType::vec3, "m/s", {}, "[0, 0, 0]", "initial velocity"},
 };
 constexpr KeyDoc bond_law_key{"law", KeyType::choice, "", {}, "", "the bond law (arlequin laws); its own keys follow in 'bond (law: ...)'",
-                              "beam | spring"};
+                              "beam | spring | cohesive_bilinear"};
 constexpr KeyDoc dem_bond_keys[] = {
     bond_law_key,
     {"tolerance", KeyType::number, "1", Range::between(0, 1), "(the packing's, else 0.01)", "gap, over the mean radius, below which two DEs bond"},
@@ -264,17 +265,29 @@ std::vector<std::string> read_materials(CaseNode dem_node, dem::DemModel& model,
     list[m].bond->finish();
   }
   dem::BondSet* interface = nullptr;
+  std::optional<CaseNode> interface_bond;
   if (auto section = dem_node.child_if("interface")) {
-    CaseNode bond = section->child("bond");
-    interface = &model.add_bond_set(dem::make_bond_set(bond));
+    interface_bond = section->child("bond");
+    interface = &model.add_bond_set(dem::make_bond_set(*interface_bond));
     interface->name = "interface";
-    bond.finish();
+    interface_bond->finish();
     section->finish();
   }
   for (auto [i, j] : dem::close_pairs(p, tolerance)) {
     const int a = material_of[i], b = material_of[j];
     dem::BondSet* set = a == b ? set_of[a] : interface;
     if (set) set->add(i, j, p);
+  }
+  if (interface) {
+    // An interface law that joins nothing, or whose links all start failed, is a mistake in the
+    // materials' regions or in the pre-crack, not a model.
+    if (interface->size() == 0)
+      interface_bond->fail("law", "no pair of DEs of two different materials is close enough to join: the materials' regions "
+                                  "do not meet (or raise dem.bond_tolerance)");
+    const auto broken = interface->broken();
+    if (std::count(broken.begin(), broken.end(), std::uint8_t{1}) == std::ptrdiff_t(broken.size()))
+      interface_bond->fail("precrack", "the pre-crack holds every one of the interface's " + std::to_string(broken.size()) +
+                                           " links: it is as long as the specimen, nothing is left to crack");
   }
   std::vector<std::string> names;
   for (std::size_t m = 0; m < list.size(); ++m) {

@@ -5,12 +5,14 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/region.hpp"
 #include "common/schema.hpp"
+#include "dem/crack_front.hpp"
 #include <unistd.h>
 #include <cerrno>
 #include <cstring>
@@ -20,10 +22,16 @@ namespace {
 
 constexpr KeyDoc sensor_keys[] = {
     {"name", KeyType::string, "", {}, "", "column name (with _x, _y, _z per component)"},
-    {"type", KeyType::choice, "", {}, "", "what it measures", "force | displacement | velocity | energy | affine_deviation"},
+    {"type", KeyType::choice, "", {}, "", "what it measures", "force | displacement | velocity | energy | affine_deviation | crack"},
     {"on", KeyType::choice, "", {}, "(dem if the case has DEs)", "which model's group", "dem | continuum"},
     {"group", KeyType::string, "", {}, "", "the group measured (reaction force, mean displacement or velocity, energy)"},
     {"component", KeyType::choice, "", {}, "all", "one component, or all three", "x | y | z | all"},
+    {"bonds", KeyType::string, "", {}, "interface", "crack: the bond set whose failed links are measured"},
+    {"quantity", KeyType::choice, "", {}, "tip", "crack: what is measured (docs/theory.md#crack-measures)",
+     "tip | damage_front | crack_growth | softening_zone | process_zone | dissipated"},
+    {"axis", KeyType::vec3, "1", {}, "[1, 0, 0]", "crack: the direction the crack runs along"},
+    {"across", KeyType::vec3, "1", {}, "[0, 1, 0]", "crack: the width direction, averaged over"},
+    {"bins", KeyType::integer, "", Range::at_least(1), "8", "crack: strips across the width"},
 };
 constexpr KeyDoc check_keys[] = {
     {"column", KeyType::string, "", {}, "", "the series.csv column judged"},
@@ -68,8 +76,10 @@ constexpr SchemaSection output_sections[] = {
 std::span<const SchemaSection> output_schema() { return output_sections; }
 
 void read_sensors(CaseNode root, Scene& scene) {
-  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy", "affine_deviation"};
+  static constexpr std::string_view types[] = {"force", "displacement", "velocity", "energy", "affine_deviation", "crack"};
   static constexpr std::string_view models[] = {"dem", "continuum"};
+  static constexpr std::string_view crack_quantities[] = {"tip", "damage_front", "crack_growth", "softening_zone", "process_zone",
+                                                          "dissipated"};
   const bool has_dem = scene.dem.particles.size() > 0;
   for (CaseNode s : root.list_or_empty("sensors")) {
     Sensor sensor;
@@ -84,6 +94,34 @@ void read_sensors(CaseNode root, Scene& scene) {
       if (!scene.initial_gradient) s.fail("type", "an affine_deviation sensor needs an initial_strain section");
       sensor.kind = Sensor::Kind::affine_deviation;
       sensor.component = 0;
+      s.finish();
+      scene.sensors.push_back(sensor);
+      continue;
+    }
+    if (type == "crack") {
+      sensor.kind = Sensor::Kind::crack;
+      sensor.component = 0;
+      const std::string set_name = s.string_or("bonds", "interface");
+      const auto& sets = scene.dem.bond_sets();
+      for (std::size_t k = 0; k < sets.size(); ++k)
+        if (sets[k]->name == set_name) sensor.crack.bond_set = int(k);
+      if (sensor.crack.bond_set < 0) s.fail("bonds", "no bond set named '" + set_name + "'");
+      const std::string quantity = s.choice_or("quantity", "tip", crack_quantities);
+      sensor.crack.quantity = Sensor::CrackQuantity(
+          std::find(std::begin(crack_quantities), std::end(crack_quantities), quantity) - std::begin(crack_quantities));
+      for (auto [key, fallback, target] : {std::tuple{"axis", Vec3{1, 0, 0}, &sensor.crack.axis},
+                                           std::tuple{"across", Vec3{0, 1, 0}, &sensor.crack.across}}) {
+        const Vec3 v = s.vec3_or(key, fallback, Range::any(), "1");
+        if (!(norm(v) > 0.0)) s.fail(key, "expected a non-zero direction");
+        *target = normalized(v);
+      }
+      sensor.crack.bins = int(s.integer_or("bins", 8, Range::at_least(1)));
+      const auto& set = *sets[sensor.crack.bond_set];
+      sensor.crack.initial_tip = dem::measure_crack(set, scene.dem.particles, sensor.crack.axis, sensor.crack.across,
+                                                    sensor.crack.bins).tip;
+      if (std::isnan(sensor.crack.initial_tip) && sensor.crack.quantity != Sensor::CrackQuantity::tip &&
+          sensor.crack.quantity != Sensor::CrackQuantity::damage_front && sensor.crack.quantity != Sensor::CrackQuantity::dissipated)
+        s.fail("quantity", "lengths from the initial tip need links that start failed (a pre-crack)");
       s.finish();
       scene.sensors.push_back(sensor);
       continue;
@@ -262,6 +300,7 @@ std::vector<std::string> sensor_units(const Scene& scene) {
                        : s.kind == Sensor::Kind::displacement ? "m"
                        : s.kind == Sensor::Kind::velocity     ? "m/s"
                        : s.kind == Sensor::Kind::energy       ? "J"
+                       : s.kind == Sensor::Kind::crack        ? (s.crack.quantity == Sensor::CrackQuantity::dissipated ? "J" : "m")
                                                               : "1";
     out.insert(out.end(), s.component >= 0 ? 1 : 3, unit);
   }

@@ -17,6 +17,7 @@
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
 #include "common/plots.hpp"
+#include "dem/crack_front.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -133,8 +134,23 @@ class Outputs {
         return {scene_.dem.group_energy(s.group), 0.0, 0.0};
       case Sensor::Kind::affine_deviation:
         return {affine_deviation(), 0.0, 0.0};
+      case Sensor::Kind::crack:
+        return {crack_measure(s.crack), 0.0, 0.0};
     }
     return {};
+  }
+
+  double crack_measure(const Sensor::Crack& c) const {
+    const auto m = dem::measure_crack(*scene_.dem.bond_sets()[c.bond_set], scene_.dem.particles, c.axis, c.across, c.bins);
+    switch (c.quantity) {
+      case Sensor::CrackQuantity::tip: return m.tip;
+      case Sensor::CrackQuantity::damage_front: return m.damage_front;
+      case Sensor::CrackQuantity::crack_growth: return m.tip - c.initial_tip;
+      case Sensor::CrackQuantity::softening_zone: return m.damage_front - c.initial_tip;
+      case Sensor::CrackQuantity::process_zone: return m.damage_front - m.tip;
+      case Sensor::CrackQuantity::dissipated: return m.dissipated;
+    }
+    return 0.0;
   }
 
   // max |u - H X| / max |H X| over the DEs (u = position - reference, X = reference) and the
@@ -157,14 +173,15 @@ class Outputs {
   // so a long failure run with many breaks costs linear, not quadratic, I/O.
   void write_breaks(bool force) {
     const auto& breaks = scene_.dem.breaks();
-    if (breaks_text_.empty()) breaks_text_ = "time,set,bond,group,criterion,mode,stress,energy\n";
-    char line[256];
+    if (breaks_text_.empty()) breaks_text_ = "time,set,bond,first,second,group,criterion,mode,stress,energy,mode_mix\n";
+    char line[320], mix[32] = "";
     for (; breaks_formatted_ < breaks.size(); ++breaks_formatted_) {
       const auto& e = breaks[breaks_formatted_];
       const auto& set = *scene_.dem.bond_sets()[e.set];
-      std::snprintf(line, sizeof line, "%.12g,%u,%u,%s,%s,%s,%.9g,%.9g\n", e.time, e.set, e.bond, set.name.c_str(),
-                    std::string(dem::name_of(e.criterion)).c_str(), std::string(dem::name_of(e.mode)).c_str(), e.stress,
-                    e.energy);
+      if (e.mode_mix >= 0.0) std::snprintf(mix, sizeof mix, "%.6g", e.mode_mix);
+      std::snprintf(line, sizeof line, "%.12g,%u,%u,%u,%u,%s,%s,%s,%.9g,%.9g,%s\n", e.time, e.set, e.bond, set.first()[e.bond],
+                    set.second()[e.bond], set.name.c_str(), std::string(dem::name_of(e.criterion)).c_str(),
+                    std::string(dem::name_of(e.mode)).c_str(), e.stress, e.energy, e.mode_mix >= 0.0 ? mix : "");
       breaks_text_ += line;
     }
     const auto now = std::chrono::steady_clock::now();

@@ -24,13 +24,22 @@ namespace arlequin::app {
 struct Sensor {
   // energy: DEM groups, one column; affine_deviation: one column, the whole scene's
   // max |u - H X| / max |H X| over DEs and continuum nodes against initial_strain's H.
-  enum class Kind { force, displacement, velocity, energy, affine_deviation };
+  // crack: one column, a measure of a bond set's failed links (dem/crack_front.hpp).
+  enum class Kind { force, displacement, velocity, energy, affine_deviation, crack };
+  enum class CrackQuantity { tip, damage_front, crack_growth, softening_zone, process_zone, dissipated };
   std::string name;
   Kind kind = Kind::force;
   bool on_continuum = false;  // else on the DEM
   int group = -1;             // DEM group index
   std::string group_name;
   int component = -1;  // 0, 1, 2, or -1 for all three
+  struct Crack {
+    int bond_set = -1;
+    CrackQuantity quantity = CrackQuantity::tip;
+    Vec3 axis{1, 0, 0}, across{0, 1, 0};  // unit vectors
+    int bins = 8;
+    double initial_tip = 0.0;  // m, the tip when the scene was built (the pre-crack's)
+  } crack;
 };
 
 // An acceptance check of the case against its reference, evaluated on series.csv after the run:

@@ -59,18 +59,22 @@ void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const Outp
   if (!plan.bond_fields || dem.bond_sets().empty()) return;
   std::vector<std::int64_t> lines;
   std::vector<std::int32_t> set_of, broken;
+  std::vector<double> damage;  // 0 or 1 (broken), or a cohesive link's softening damage
   for (std::size_t s = 0; s < dem.bond_sets().size(); ++s) {
     const dem::BondSet& set = *dem.bond_sets()[s];
+    const auto softening = set.damage_values();
     for (std::size_t b = 0; b < set.size(); ++b) {
       lines.push_back(set.first()[b]);
       lines.push_back(set.second()[b]);
       set_of.push_back(static_cast<std::int32_t>(s));
       broken.push_back(set.broken()[b]);
+      damage.push_back(softening.empty() ? set.broken()[b] : softening[b]);
     }
   }
   fields.add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, lines);
   fields.add_cell_field("bonds", "bond_set", set_of);
   fields.add_cell_field("bonds", "broken", broken);
+  fields.add_cell_field("bonds", "damage", damage);
 }
 
 }  // namespace arlequin::app

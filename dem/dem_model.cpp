@@ -148,7 +148,8 @@ void DemModel::advance_to_forces(double dt) {
   // an output row: also each bond's energy.
   ForceScan scan = failure_on_ ? failure_scan() : ForceScan{};
   scan.energy = std::exchange(energy_record_requested_, false);
-  compute_forces(scan);
+  // Friction's power at the half-step velocities, over the step (as the damping's work).
+  dissipated_ += dt * compute_forces(scan);
   if (failure_on_) apply_failures(scan.energy);  // BBF / RDEF: break bonds, forces again if any broke
   energy_record_step_ = scan.energy ? steps_ + 1 : -1;
   record_reactions();                 // for sensors, and the work of driven DEs
@@ -231,10 +232,10 @@ void DemModel::update_neighbours() {
   if (neighbours_ && neighbours_->needs_rebuild(particles)) neighbours_->build(particles);
 }
 
-void DemModel::compute_forces(const ForceScan& scan) {
+double DemModel::compute_forces(const ForceScan& scan) {
   particles.clear_forces();
   for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
-  if (contact_) contact_->accumulate_forces(*neighbours_, particles);
+  return contact_ ? contact_->accumulate_forces(*neighbours_, particles) : 0.0;
 }
 
 ForceScan DemModel::failure_scan() {
@@ -374,6 +375,14 @@ Energies DemModel::energies() const {
   e.external_work = external_work_;
   e.dissipated = dissipated_;
   e.fracture = fracture_;
+  // Cohesive links still intact have dissipated part of their toughness; a failed link's share
+  // is in fracture_ already (its break event).
+  for (const auto& set : bond_sets_) {
+    const auto dissipated = set->dissipated_values();
+    const auto broken = set->broken();
+    for (std::size_t b = 0; b < dissipated.size(); ++b)
+      if (!broken[b]) e.fracture += dissipated[b];
+  }
   return e;
 }
 

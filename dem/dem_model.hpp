@@ -28,8 +28,9 @@ struct Energies {
   double bond = 0.0;           // elastic energy in bonds, J
   double contact = 0.0;        // elastic energy in contacts, J
   double external_work = 0.0;  // work done on the model by boundary conditions and loads, J
-  double dissipated = 0.0;     // by viscous damping, J
-  double fracture = 0.0;       // elastic energy of bonds when they broke, J
+  double dissipated = 0.0;     // by viscous damping and contact friction, J
+  double fracture = 0.0;       // elastic energy of bonds when they broke, and what cohesive
+                               // links dissipated softening, J
   double total() const { return kinetic + bond + contact; }
   // Zero for an exact run: what is stored plus what was lost, less the work put in.
   double balance(double initial_total) const { return total() + dissipated + fracture - external_work - initial_total; }
@@ -124,7 +125,7 @@ class DemModel {
   void impose_motion(double t, bool half_step, double dt);
   void drift(double dt);
   void update_neighbours();
-  void compute_forces(const ForceScan& scan = {});
+  double compute_forces(const ForceScan& scan = {});  // returns the friction's power, W
   // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();

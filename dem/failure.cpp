@@ -76,6 +76,7 @@ std::string_view name_of(FailureCriterion c) {
     case FailureCriterion::bbf: return "bbf";
     case FailureCriterion::elongation: return "elongation";
     case FailureCriterion::rdef: return "rdef";
+    case FailureCriterion::cohesive: return "cohesive";
   }
   return "";
 }

@@ -63,7 +63,7 @@ enum class RdefVolume : std::uint8_t { sphere, laguerre };
 // along the bond (sphere volumes), or on the radical plane (Laguerre cells).
 enum class VirialBranch : std::uint8_t { half, radical };
 
-enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef };
+enum class FailureCriterion : std::uint8_t { bbf, elongation, rdef, cohesive };
 enum class FailureMode : std::uint8_t { tension, compression, bending, shear, torsion };
 std::string_view name_of(FailureCriterion c);
 std::string_view name_of(FailureMode m);
@@ -75,7 +75,9 @@ struct BreakEvent {
   FailureCriterion criterion = FailureCriterion::bbf;
   FailureMode mode = FailureMode::tension;  // dominant stress at break
   double stress = 0.0;        // criterion value at break (Pa, or elongation for springs)
-  double energy = 0.0;        // elastic energy the bond held, now dissipated (J)
+  double energy = 0.0;        // elastic energy the bond held, now dissipated (J); a cohesive
+                              // link's: what its softening dissipated, and what it still held
+  double mode_mix = -1.0;     // cohesive links: shear share B of the opening at failure; -1 else
 };
 
 }  // namespace arlequin::dem

@@ -19,6 +19,12 @@
 //   void reorder(order);                                apply_order to each per-bond array
 //   void scale(b, factor);                              every stiffness of bond b times factor
 //   void add_frequency_bound(b, p, translational, rotational) const;   see BondSet
+// A law with history (a damage variable) may also supply
+//   void commit(b, const Evaluation&) const;            keep what the force pass evaluated
+//   double event_energy(b, const Evaluation&) const;    a failure's dissipated energy (else energy_of)
+//   double event_mode_mix(b, const Evaluation&) const;  a failure's mode mix (else none)
+// commit is called by the force pass only, after each evaluation, so evaluate() stays a pure
+// function of the configuration and the stored history.
 // A law with a faster pass of its own (the beam's SIMD blocks) overrides accumulate_forces and
 // records each bond with record_scan, so both passes record the same.
 #pragma once
@@ -94,6 +100,8 @@ class BondKernelSet : public BondSet {
 
  private:
   const Law& self() const { return static_cast<const Law&>(*this); }
+  static constexpr bool has_history =
+      requires(const Law& law, std::size_t b, const typename Law::Evaluation& e) { law.commit(b, e); };
   Law& mutable_self() { return static_cast<Law&>(*this); }
 };
 
@@ -118,12 +126,17 @@ template <class Law>
 void BondKernelSet<Law>::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
   const Records r = records(scan);
   if (!r.any()) {  // the plain pass: no test per bond
-    for_each_bond(colouring_, [&](std::size_t b) { apply(b, self().evaluate(b, p), p); });
+    for_each_bond(colouring_, [&](std::size_t b) {
+      const auto e = self().evaluate(b, p);
+      apply(b, e, p);
+      if constexpr (has_history) self().commit(b, e);
+    });
     return;
   }
   for_each_bond(colouring_, [&](std::size_t b) {
     const auto e = self().evaluate(b, p);
     apply(b, e, p);
+    if constexpr (has_history) self().commit(b, e);
     record_scan(b, e, p, scan, r);
   });
 }
@@ -159,8 +172,11 @@ void BondKernelSet<Law>::find_failures(const ParticleSet& p, std::uint32_t set_i
   for (std::size_t b = 0; b < size(); ++b) {
     if (broken_[b] || measure_[b] < strength) continue;
     const auto e = self().evaluate(b, p);
-    events.push_back({time, set_index, static_cast<std::uint32_t>(b), Law::criterion, self().mode_of(b, e), measure_[b],
-                      self().energy_of(b, e)});
+    BreakEvent event{time, set_index, static_cast<std::uint32_t>(b), Law::criterion, self().mode_of(b, e), measure_[b],
+                     self().energy_of(b, e)};
+    if constexpr (requires { self().event_energy(b, e); }) event.energy = self().event_energy(b, e);
+    if constexpr (requires { self().event_mode_mix(b, e); }) event.mode_mix = self().event_mode_mix(b, e);
+    events.push_back(event);
   }
 }
 

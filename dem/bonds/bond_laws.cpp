@@ -5,6 +5,7 @@
 // (3) test it on two DEs against its closed form.
 #include "common/registry.hpp"
 #include "dem/bonds/beam_bond.hpp"
+#include "dem/bonds/cohesive_contact.hpp"
 #include "dem/bonds/spring_bond.hpp"
 
 namespace arlequin::dem {
@@ -13,6 +14,8 @@ std::span<const BondLawEntry> bond_laws() {
   static const BondLawEntry table[] = {
       {"beam", "cohesive Euler-Bernoulli beam (Andre et al. 2012): E_mu, nu_mu, r_mu, sigma_f", &BeamBondSet::make, &BeamBondSet::keys},
       {"spring", "axial spring for yarns (seed Eq. 6): stiffness, max_elongation", &SpringBondSet::make, &SpringBondSet::keys},
+      {"cohesive_bilinear", "bilinear cohesive contact across an interface (seed Eq. 2, mixed mode B-K): sigma_max, G_I, stiffness, precrack",
+       &CohesiveContactSet::make, &CohesiveContactSet::keys},
   };
   return table;
 }

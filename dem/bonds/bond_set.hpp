@@ -133,6 +133,13 @@ class BondSet {
                              std::vector<BreakEvent>& events) const = 0;
   virtual void accumulate_virial(const ParticleSet& p, VirialBranch branch, std::span<Sym3> virial) const = 0;
   virtual double bond_energy(std::size_t b, const ParticleSet& p) const = 0;
+  // Laws with a damage variable (cohesive links): each bond's damage in [0, 1] and the energy
+  // its softening has dissipated so far, J (a failed bond's included). Empty for the others,
+  // whose bonds are intact or broken (broken()).
+  virtual std::span<const double> damage_values() const { return {}; }
+  virtual std::span<const double> dissipated_values() const { return {}; }
+  // A line about the set beyond its size, for the scene's facts (empty: nothing to add).
+  virtual std::string describe() const { return {}; }
   // A broken bond keeps its place but its stiffness is zero: it carries no force from the
   // next force evaluation on, and the force loop needs no branch for it.
   void break_bond(std::size_t b) {

@@ -8,6 +8,12 @@
 //       the force on DE j of a pair with d = x_j - x_i, |d| = distance < reach = R_i + R_j, N
 //   double energy_of(double overlap) const;    elastic energy at overlap = reach - distance > 0, J
 //   double stiffness() const override;        the largest normal stiffness, N/m (time step)
+//   double friction() const;                  Coulomb coefficient mu (0: frictionless)
+//   double slip_velocity() const;             regularisation of the friction, m/s
+// Friction (docs/theory.md#contact-friction): the tangential force on j opposes the sliding
+// velocity v_t of the contact point, F_t = -mu |F_n| v_t / max(|v_t|, v_slip): Coulomb while
+// sliding faster than v_slip, viscous below it (no history, so the neighbour list can be
+// rebuilt freely); it acts at the contact point, hence torques. Its power is returned.
 #pragma once
 #include <cmath>
 
@@ -20,16 +26,21 @@ class ContactKernelLaw : public ContactLaw {
  public:
   std::string_view law() const override { return Law::name; }
 
-  void accumulate_forces(const NeighbourList& list, ParticleSet& p) const override {
+  double accumulate_forces(const NeighbourList& list, ParticleSet& p) const override {
+    const double mu = self().friction();
+    double power = 0.0;
     for (auto [i, j] : list.pairs()) {
       const Vec3 d = p.position[j] - p.position[i];
       const double reach = p.radius[i] + p.radius[j];
       const double dist2 = norm2(d);
       if (dist2 >= reach * reach) continue;  // a listed pair that does not touch
-      const Vec3 f_j = self().force_on_j(d, std::sqrt(dist2), reach);
+      const double distance = std::sqrt(dist2);
+      const Vec3 f_j = self().force_on_j(d, distance, reach);
       p.force[i] -= f_j;
       p.force[j] += f_j;
+      if (mu > 0.0) power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
     }
+    return power;
   }
 
   double energy(const NeighbourList& list, const ParticleSet& p) const override {
@@ -43,6 +54,24 @@ class ContactKernelLaw : public ContactLaw {
 
  private:
   const Law& self() const { return static_cast<const Law&>(*this); }
+
+  // Friction of the pair (i, j) touching along n with normal force magnitude f_n: added to both
+  // DEs at the contact point, half the overlap inside each sphere (so the two arms add up to the
+  // centre distance and the pair's angular momentum is kept); returns its dissipated power, W.
+  double add_friction(std::uint32_t i, std::uint32_t j, const Vec3& n, double half_overlap, double f_n, double mu,
+                      ParticleSet& p) const {
+    const Vec3 arm_i = n * (p.radius[i] - half_overlap), arm_j = n * (half_overlap - p.radius[j]);  // centre -> contact
+    const Vec3 v = (p.velocity[j] + cross(p.angular_velocity[j], arm_j)) - (p.velocity[i] + cross(p.angular_velocity[i], arm_i));
+    const Vec3 v_t = v - n * dot(v, n);
+    const double speed = norm(v_t);
+    if (speed == 0.0) return 0.0;
+    const Vec3 f_t = v_t * (-mu * f_n / std::max(speed, self().slip_velocity()));
+    p.force[j] += f_t;
+    p.force[i] -= f_t;
+    p.torque[j] += cross(arm_j, f_t);
+    p.torque[i] += cross(arm_i, -f_t);
+    return -dot(f_t, v_t);
+  }
 };
 
 }  // namespace arlequin::dem

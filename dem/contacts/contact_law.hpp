@@ -1,7 +1,8 @@
 // Contact laws act on the pairs of a NeighbourList.
 //
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually
-// touching (|x_i - x_j| < R_i + R_j); energy() is the elastic energy of those contacts;
+// touching (|x_i - x_j| < R_i + R_j) and returns the power its friction dissipates at the
+// present velocities (W, >= 0; 0 for a frictionless law); energy() is the elastic energy of those contacts;
 // stiffness() is the largest normal stiffness a contact can have (N/m), for the critical
 // time step. One virtual call per batch of pairs, none per pair.
 #pragma once
@@ -23,7 +24,7 @@ class ContactLaw {
  public:
   virtual ~ContactLaw() = default;
   virtual std::string_view law() const = 0;
-  virtual void accumulate_forces(const NeighbourList& list, ParticleSet& p) const = 0;
+  virtual double accumulate_forces(const NeighbourList& list, ParticleSet& p) const = 0;
   virtual double energy(const NeighbourList& list, const ParticleSet& p) const = 0;
   virtual double stiffness() const = 0;
 };

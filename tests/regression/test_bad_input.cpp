@@ -35,6 +35,9 @@ struct BadInput {
   std::string replacement;  // new text of that line
   std::string extra_args;   // appended to the command line
   std::vector<std::string> expected;  // substrings of the error line
+  // A second line to replace (0: none), given by the cases that need it only.
+  int line2 = 0;
+  std::string replacement2 = "";
 };
 
 std::ostream& operator<<(std::ostream& os, const BadInput& b) { return os << b.name; }
@@ -48,7 +51,7 @@ TEST_P(BadInputTest, OneLineErrorNamingWhereAndNonZeroExit) {
   {
     std::ofstream out(file);
     for (std::size_t k = 0; k < valid_case.size(); ++k)
-      out << (int(k) + 1 == b.line ? b.replacement : valid_case[k]) << "\n";
+      out << (int(k) + 1 == b.line ? b.replacement : int(k) + 1 == b.line2 ? b.replacement2 : valid_case[k]) << "\n";
   }
   const auto r = test::run_arlequin("check " + file.string() + " " + b.extra_args);
   EXPECT_EQ(r.exit_code, 2) << r.output;
@@ -110,6 +113,32 @@ INSTANTIATE_TEST_SUITE_P(
                  {"case.yaml:2", "time.end", "no step would run"}},
         BadInput{"misspelt_required_key", 6, "  bond: {law: beam, E_m: 2.0e11, r_mu: 0.5}", "",
                  {"case.yaml:6", "missing required key 'E_mu'", "is 'E_m' (line 6) a misspelling of 'E_mu'?"}},
+        // The cohesive interface of two materials (the chain's DEs 0, 1 and 2 split at x = 3 mm).
+        BadInput{"cohesive_strength_not_positive", 6,
+                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
+                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: -5.7e6, G_I: 560, stiffness: 1.0e15}}", "",
+                 {"case.yaml:7", "dem.interface.bond.sigma_max", "> 0"}, 4, "  # density: per material"},
+        BadInput{"cohesive_toughness_not_positive", 6,
+                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
+                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 0, stiffness: 1.0e15}}", "",
+                 {"case.yaml:7", "dem.interface.bond.G_I", "> 0"}, 4, "  # density: per material"},
+        BadInput{"cohesive_u_p_below_elastic_opening", 6,
+                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
+                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e4}}", "",
+                 {"case.yaml:7", "dem.interface.bond.G_I", "not beyond the elastic opening"}, 4, "  # density: per material"},
+        BadInput{"cohesive_interface_crossed_by_no_pair", 6,
+                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [1, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
+                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15}}", "",
+                 {"case.yaml:", "dem.interface.bond.law", "no pair of DEs"}, 4, "  # density: per material"},
+        BadInput{"cohesive_precrack_longer_than_specimen", 6,
+                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
+                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15, precrack: {box: [[-1, -1, -1], [1, 1, 1]]}}}", "",
+                 {"case.yaml:", "dem.interface.bond.precrack", "as long as the specimen"}, 4, "  # density: per material"},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),

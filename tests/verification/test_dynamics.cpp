@@ -181,6 +181,34 @@ TEST(PenaltyContact, HeadOnImpactConservesEnergy) {
   EXPECT_LT(worst, 1e-3 * e0);
 }
 
+// Friction (docs/theory.md#contact-friction): DE 1 overlaps the resting DE 0 by delta and slides
+// past it along y at v. Sliding faster than v_slip: F_t = -mu K delta y on DE 1, applied at the
+// contact point, delta/2 inside each sphere, so its torque is (-(R - delta/2) x) x F_t (and the
+// pair's angular momentum is kept); the power dissipated mu K delta v. Slower: the force is
+// scaled by v / v_slip.
+TEST(PenaltyContact, FrictionOpposesSlidingWithTheCoulombForce) {
+  const double R = 1e-3, K = 1e6, delta = 1e-5, mu = 0.3, v_slip = 1e-3;
+  for (double v : {0.5, 0.25 * v_slip}) {
+    ParticleSet p;
+    p.add({0, 0, 0}, R, steel);
+    p.add({2 * R - delta, 0, 0}, R, steel);
+    p.velocity[1] = {0, v, 0};
+    NeighbourList list(0.2 * R);
+    list.build(p);
+    const PenaltyContact law(K, mu, v_slip);
+    p.clear_forces();
+    const double power = law.accumulate_forces(list, p);
+    const double f_t = mu * K * delta * std::min(1.0, v / v_slip);
+    EXPECT_NEAR(p.force[1].x, K * delta, 1e-9 * K * delta);
+    EXPECT_NEAR(p.force[1].y, -f_t, 1e-9 * f_t);
+    EXPECT_NEAR(p.force[0].y, f_t, 1e-9 * f_t);
+    const double arm = R - delta / 2;
+    EXPECT_NEAR(p.torque[1].z, arm * f_t, 1e-9 * R * f_t);
+    EXPECT_NEAR(p.torque[0].z, arm * f_t, 1e-9 * R * f_t);
+    EXPECT_NEAR(power, f_t * v, 1e-9 * f_t * v);
+  }
+}
+
 TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
   model.finalize();
   EXPECT_LE(model.critical_time_step(), 2.0 / omega_axial);

@@ -1,0 +1,194 @@
+#include "dem/bonds/cohesive_contact.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+
+#include "common/case_file.hpp"
+#include "common/quat.hpp"
+
+namespace arlequin::dem {
+
+template class BondKernelSet<CohesiveContactSet>;
+
+constexpr KeyDoc cohesive_keys[] = {
+    {"sigma_max", KeyType::number, "Pa", Range::positive(), "", "normal strength sigma_max^n (seed Eq. 2)"},
+    {"sigma_max_shear", KeyType::number, "Pa", Range::positive(), "(sigma_max)", "shear strength sigma_max^s"},
+    {"G_I", KeyType::number, "J/m^2", Range::positive(), "", "mode I toughness: u_p^n = 2 G_I / sigma_max (seed Eq. 2)"},
+    {"G_II", KeyType::number, "J/m^2", Range::positive(), "(G_I)", "mode II toughness: u_p^s = 2 G_II / sigma_max_shear"},
+    {"stiffness", KeyType::number, "Pa/m", Range::positive(), "", "traction per opening before damage, both directions"},
+    {"bk_exponent", KeyType::number, "1", Range::positive(), "2", "Benzeggagh-Kenane exponent eta of the mixed-mode toughness"},
+    {"precrack", KeyType::section, "", {}, "(none)", "a region: links whose mid-point lies in it start failed"},
+    {"area", KeyType::number, "m^2", Range::positive(), "(none)", "nominal interface area the links' sections are scaled to add up to"},
+};
+std::span<const KeyDoc> CohesiveContactSet::keys() { return cohesive_keys; }
+
+CohesiveContactSet::CohesiveContactSet(const Parameters& parameters) : parameters_(parameters) {
+  const Parameters& q = parameters_;
+  const auto require_positive = [](double value, const char* key) {
+    if (!(value > 0.0) || !std::isfinite(value)) throw std::invalid_argument(std::string(key) + ": expected a positive number");
+  };
+  require_positive(q.strength_normal, "sigma_max");
+  require_positive(q.strength_shear, "sigma_max_shear");
+  require_positive(q.toughness_I, "G_I");
+  require_positive(q.toughness_II, "G_II");
+  require_positive(q.stiffness, "stiffness");
+  require_positive(q.bk_exponent, "bk_exponent");
+  // Softening needs the failure opening u_p = 2 G / sigma beyond the elastic one sigma / k.
+  const auto check_mode = [&](double strength, double toughness, const char* key) {
+    const double elastic = strength / q.stiffness, failure = 2.0 * toughness / strength;
+    if (!(failure > elastic)) {
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "u_p = 2 G / sigma = %.4g m is not beyond the elastic opening sigma / stiffness = %.4g m; "
+                    "raise the stiffness above %.4g Pa/m or the toughness",
+                    failure, elastic, strength * strength / (2.0 * toughness));
+      throw std::invalid_argument(std::string(key) + ": " + msg);
+    }
+  };
+  check_mode(q.strength_normal, q.toughness_I, "G_I");
+  check_mode(q.strength_shear, q.toughness_II, "G_II");
+}
+
+std::unique_ptr<BondSet> CohesiveContactSet::make(CaseNode& section) {
+  Parameters q;
+  q.strength_normal = section.number("sigma_max", Range::positive(), "Pa");
+  q.strength_shear = section.number_or("sigma_max_shear", q.strength_normal, Range::positive(), "Pa");
+  q.toughness_I = section.number("G_I", Range::positive(), "J/m^2");
+  q.toughness_II = section.number_or("G_II", q.toughness_I, Range::positive(), "J/m^2");
+  q.stiffness = section.number("stiffness", Range::positive(), "Pa/m");
+  q.bk_exponent = section.number_or("bk_exponent", 2.0, Range::positive(), "1");
+  if (auto region = section.child_if("precrack")) {
+    q.precrack = Region::read(*region);
+    region->finish();
+  }
+  if (section.has("area")) q.area = section.number("area", Range::positive(), "m^2");
+  try {
+    return std::make_unique<CohesiveContactSet>(q);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    const auto colon = what.find(": ");
+    section.fail(what.substr(0, colon), what.substr(colon + 2));
+  }
+}
+
+void CohesiveContactSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) {
+  const Quat identity{};
+  if (!(p.orientation[i].w == identity.w && p.orientation[i].v == identity.v && p.orientation[j].w == identity.w &&
+        p.orientation[j].v == identity.v))
+    throw std::logic_error("CohesiveContactSet::add: DEs must have their reference orientation");
+  add_pair(i, j);
+  const Vec3 d0 = p.position[j] - p.position[i];
+  const double Ri = p.radius[i], Rj = p.radius[j];
+  offset_i_.push_back(d0 * (Ri / (Ri + Rj)));
+  offset_j_.push_back(d0 * (-Rj / (Ri + Rj)));
+  const double R = 0.5 * (Ri + Rj);
+  section_.push_back(std::numbers::pi * R * R);
+  stiffness_.push_back(parameters_.stiffness * section_.back());
+  damage_.push_back(0.0);
+  dissipated_.push_back(0.0);
+  if (parameters_.precrack && parameters_.precrack->contains(p.position[i] + offset_i_.back())) {
+    broken_.back() = 1;
+    damage_.back() = 1.0;
+    stiffness_.back() = 0.0;
+  }
+}
+
+void CohesiveContactSet::finalize(std::size_t n_particles) {
+  if (parameters_.area > 0.0 && size() > 0) {
+    double total = 0.0;
+    for (double s : section_) total += s;
+    section_scale_ = parameters_.area / total;
+    for (std::size_t b = 0; b < size(); ++b) {
+      section_[b] *= section_scale_;
+      stiffness_[b] *= section_scale_;
+    }
+  }
+  BondKernelSet<CohesiveContactSet>::finalize(n_particles);
+}
+
+CohesiveContactSet::Evaluation CohesiveContactSet::evaluate(std::size_t b, const ParticleSet& p) const {
+  const std::uint32_t i = first_[b], j = second_[b];
+  const Vec3 arm_i = rotate(p.orientation[i], offset_i_[b]), arm_j = rotate(p.orientation[j], offset_j_[b]);
+  const Vec3 d = p.position[j] - p.position[i];
+  const Vec3 n = d / norm(d);
+  const Vec3 u = (p.position[j] + arm_j) - (p.position[i] + arm_i);
+  const double un = dot(u, n);
+  const Vec3 us = u - n * un;
+  const double s2 = norm2(us);
+  const double opening = std::max(un, 0.0), closing = std::max(-un, 0.0);
+  const double lambda2 = opening * opening + s2;
+  const double lambda = std::sqrt(lambda2);
+
+  // Onset and failure openings along the present mode mix (docs/theory.md#cohesive-contact).
+  const Parameters& q = parameters_;
+  const double k = q.stiffness;
+  const double dn0 = q.strength_normal / k, ds0 = q.strength_shear / k;
+  const double mix = lambda2 > 0.0 ? s2 / lambda2 : 0.0;  // B
+  const double lambda0 =
+      lambda2 > 0.0 ? dn0 * ds0 * std::sqrt(lambda2 / (ds0 * ds0 * opening * opening + dn0 * dn0 * s2)) : dn0;
+  const double toughness = q.toughness_I + (q.toughness_II - q.toughness_I) * std::pow(mix, q.bk_exponent);
+  const double lambda_f = std::max(2.0 * toughness / (k * lambda0), lambda0 * (1.0 + 1e-12));
+
+  const double stored = damage_[b];
+  double trial = 0.0;
+  if (lambda >= lambda_f) trial = 1.0;
+  else if (lambda > lambda0) trial = lambda_f * (lambda - lambda0) / (lambda * (lambda_f - lambda0));
+  const double damage = std::max(stored, trial);
+
+  // Fraction of G_c S dissipated once the damage is d, along this mix.
+  const auto dissipated_fraction = [&](double dmg) {
+    const double reached = lambda0 * lambda_f / (lambda_f - dmg * (lambda_f - lambda0));
+    return (reached - lambda0) / (lambda_f - lambda0);
+  };
+  Evaluation e;
+  const double K = stiffness_[b];
+  e.force_on_j = (us + n * opening) * (-K * (1.0 - damage)) + n * (K * closing);
+  e.torque_on_i = cross(arm_i, -e.force_on_j);
+  e.torque_on_j = cross(arm_j, e.force_on_j);
+  e.damage = damage;
+  e.mode_mix = mix;
+  e.elastic = 0.5 * K * ((1.0 - damage) * lambda2 + closing * closing);
+  e.dissipation = damage > stored && K > 0.0
+                      ? toughness * section_[b] * (dissipated_fraction(damage) - dissipated_fraction(stored))
+                      : 0.0;
+  return e;
+}
+
+void CohesiveContactSet::reorder(std::span<const std::uint32_t> order) {
+  apply_order(section_, order);
+  apply_order(stiffness_, order);
+  apply_order(offset_i_, order);
+  apply_order(offset_j_, order);
+  apply_order(damage_, order);
+  apply_order(dissipated_, order);
+}
+
+// Block-Gershgorin rows of a link of stiffness K whose contact point sits at a_i, a_j from the
+// centres: translational K, rotational K a_i^2 (own) and K a_i a_j (other), coupling K a.
+void CohesiveContactSet::add_frequency_bound(std::size_t b, const ParticleSet& p, std::span<double> translational,
+                                             std::span<double> rotational) const {
+  const double K = stiffness_[b];
+  const double a[2] = {norm(offset_i_[b]), norm(offset_j_[b])};
+  for (int end = 0; end < 2; ++end) {
+    const std::uint32_t i = end == 0 ? first_[b] : second_[b];
+    const std::uint32_t j = end == 0 ? second_[b] : first_[b];
+    const double ai = a[end], aj = a[1 - end];
+    const double mi = p.inv_mass[i], mj = p.inv_mass[j];
+    const double Ii = p.inv_inertia(i), Ij = p.inv_inertia(j);
+    translational[i] += K * (mi + std::sqrt(mi * mj) + ai * std::sqrt(mi * Ii) + aj * std::sqrt(mi * Ij));
+    rotational[i] += K * (ai * ai * Ii + ai * aj * std::sqrt(Ii * Ij) + ai * (std::sqrt(Ii * mi) + std::sqrt(Ii * mj)));
+  }
+}
+
+std::string CohesiveContactSet::describe() const {
+  std::size_t failed = 0;
+  for (auto f : broken_) failed += f;
+  char text[256];
+  std::snprintf(text, sizeof text, "%zu links (%zu start failed), u_p^n = %.4g m, sections x %.4f", size(), failed,
+                2.0 * parameters_.toughness_I / parameters_.strength_normal, section_scale_);
+  return text;
+}
+
+}  // namespace arlequin::dem

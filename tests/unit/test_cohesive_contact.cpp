@@ -1,0 +1,217 @@
+// The bilinear cohesive contact on two DEs against its closed forms (docs/theory.md#cohesive-contact):
+// the bilinear traction-opening curve in mode I and mode II, the quadratic onset and the
+// Benzeggagh-Kenane toughness along a fixed mixed path, the energy dissipated per unit area at
+// failure (G_I, G_II, G_c(B)) to 1e-6, unloading and reloading on the damaged stiffness, no
+// energy created over a load-unload cycle, compression as a penalty contact, no opening from a
+// rigid rotation of the pair, and a pre-cracked link that carries nothing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/quat.hpp"
+#include "dem/bonds/cohesive_contact.hpp"
+
+namespace arlequin::dem {
+namespace {
+
+// Two unit DEs L apart along x, one link (contact point midway). L is large against the
+// openings so that the line of centres barely turns: a shear opening s turns it by s / L, which
+// moves s^2 / L into the normal opening (2e-7 of it at the largest mixed opening used here);
+// the geometry is checked apart (ARigidRotationOfThePairOpensNothing).
+constexpr double sigma_n = 10.0, sigma_s = 15.0;  // Pa
+constexpr double G_I = 5e-3, G_II = 7.5e-3;       // J/m^2
+constexpr double k = 1e6;                         // Pa/m
+constexpr double L = 2000.0;                      // m
+constexpr double S = std::numbers::pi;            // R = 1
+constexpr double dn0 = sigma_n / k, dnf = 2 * G_I / sigma_n;  // 1e-5, 1e-3 m
+constexpr double ds0 = sigma_s / k, dsf = 2 * G_II / sigma_s; // 1.5e-5, 1e-3 m
+
+ForceScan criterion_scan() {
+  ForceScan scan;
+  scan.criterion = true;
+  return scan;
+}
+
+struct CohesivePair : ::testing::Test {
+  ParticleSet p;
+  std::unique_ptr<CohesiveContactSet> link;
+  double eta = 2.0;
+
+  void make(std::optional<Region> precrack = std::nullopt) {
+    p.add({0, 0, 0}, 1.0, 1.0);
+    p.add({L, 0, 0}, 1.0, 1.0);
+    CohesiveContactSet::Parameters q;
+    q.strength_normal = sigma_n;
+    q.strength_shear = sigma_s;
+    q.toughness_I = G_I;
+    q.toughness_II = G_II;
+    q.stiffness = k;
+    q.bk_exponent = eta;
+    q.precrack = precrack;
+    link = std::make_unique<CohesiveContactSet>(q);
+    link->add(0, 1, p);
+    link->finalize(2);
+  }
+  void SetUp() override { make(); }
+  // DE 1 moved by u from its reference; a force pass (which keeps the history); the force on DE 1.
+  Vec3 pull(const Vec3& u) {
+    p.position[1] = Vec3{L, 0, 0} + u;
+    p.clear_forces();
+    link->accumulate_forces(p, criterion_scan());
+    return p.force[1];
+  }
+  double dissipated() const { return link->dissipated_values()[0]; }
+  double damage() const { return link->damage_values()[0]; }
+};
+
+// Bilinear envelope of one mode: traction at opening u, Pa.
+double envelope(double u, double d0, double df, double sigma) {
+  return u <= d0 ? sigma * u / d0 : u >= df ? 0.0 : sigma * (df - u) / (df - d0);
+}
+
+TEST_F(CohesivePair, ModeIFollowsTheBilinearCurveAndDissipatesGI) {
+  for (int step = 1; step <= 1100; ++step) {
+    const double u = step * dnf / 1000;
+    const Vec3 f = pull({u, 0, 0});
+    ASSERT_NEAR(-f.x / S, envelope(u, dn0, dnf, sigma_n), 1e-6 * sigma_n) << "u = " << u;
+    ASSERT_NEAR(f.y, 0.0, 1e-12);
+  }
+  EXPECT_EQ(damage(), 1.0);
+  EXPECT_NEAR(dissipated() / S, G_I, 1e-6 * G_I);
+  std::vector<BreakEvent> events;
+  link->find_failures(p, 0, 0.0, events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].criterion, FailureCriterion::cohesive);
+  EXPECT_EQ(events[0].mode, FailureMode::tension);
+  EXPECT_NEAR(events[0].energy / S, G_I, 1e-6 * G_I);
+  EXPECT_NEAR(events[0].mode_mix, 0.0, 1e-12);
+}
+
+TEST_F(CohesivePair, ModeIIFollowsTheBilinearCurveAndDissipatesGII) {
+  for (int step = 1; step <= 1100; ++step) {
+    const double s = step * dsf / 1000;
+    const Vec3 f = pull({0, s, 0});
+    // The traction is along -u (the force keeps the opening's direction): its magnitude.
+    ASSERT_NEAR(norm(f) / S, envelope(s, ds0, dsf, sigma_s), 2e-6 * sigma_s) << "s = " << s;
+  }
+  EXPECT_EQ(damage(), 1.0);
+  EXPECT_NEAR(dissipated() / S, G_II, 1e-6 * G_II);
+  std::vector<BreakEvent> events;
+  link->find_failures(p, 0, 0.0, events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].mode, FailureMode::shear);
+  EXPECT_NEAR(events[0].mode_mix, 1.0, 1e-6);
+}
+
+// A fixed mix: opening u (cos psi, sin psi, 0). beta = tan psi; quadratic onset
+// lambda_0 = dn0 ds0 sqrt((1 + beta^2) / (ds0^2 + beta^2 dn0^2)); B = sin^2 psi;
+// G_c = G_I + (G_II - G_I) B^eta (Camanho and Davila 2002).
+TEST_F(CohesivePair, AFixedMixedPathStartsOnTheQuadraticCriterionAndDissipatesTheBKToughness) {
+  const double psi = 0.6, beta = std::tan(psi), B = std::sin(psi) * std::sin(psi);
+  const double lambda0 = dn0 * ds0 * std::sqrt((1 + beta * beta) / (ds0 * ds0 + beta * beta * dn0 * dn0));
+  const double Gc = G_I + (G_II - G_I) * std::pow(B, eta);
+  const double lambda_f = 2 * Gc / (k * lambda0);
+  const Vec3 direction{std::cos(psi), std::sin(psi), 0};
+  // At the onset the undamaged tractions meet the quadratic criterion.
+  Vec3 f = pull(direction * (lambda0 * (1 - 1e-6)));
+  EXPECT_EQ(damage(), 0.0);
+  const double tn = -f.x / S, ts = -f.y / S;
+  EXPECT_NEAR(tn * tn / (sigma_n * sigma_n) + ts * ts / (sigma_s * sigma_s), 1.0, 1e-5);
+  pull(direction * (lambda0 * (1 + 1e-3)));
+  EXPECT_GT(damage(), 0.0);
+  p = ParticleSet{};  // a fresh link for the whole curve
+  make();
+  for (int step = 1; step <= 1100; ++step) {
+    const double lambda = step * lambda_f / 1000;
+    f = pull(direction * lambda);
+    ASSERT_NEAR(norm(f) / S, envelope(lambda, lambda0, lambda_f, k * lambda0), 2e-6 * k * lambda0) << lambda;
+  }
+  EXPECT_EQ(damage(), 1.0);
+  EXPECT_NEAR(dissipated() / S, Gc, 1e-6 * Gc);
+}
+
+TEST_F(CohesivePair, UnloadingAndReloadingFollowTheDamagedStiffness) {
+  const double peak = 0.5 * (dn0 + dnf);
+  const Vec3 at_peak = pull({peak, 0, 0});
+  const double d = damage();
+  EXPECT_NEAR(d, dnf * (peak - dn0) / (peak * (dnf - dn0)), 1e-12);
+  for (double u : {0.75 * peak, 0.25 * peak, 0.0, 0.5 * peak, peak}) {
+    const Vec3 f = pull({u, 0, 0});
+    EXPECT_NEAR(-f.x, (1 - d) * k * S * u, 1e-9 * k * S * peak) << "u = " << u;
+    EXPECT_EQ(damage(), d);
+  }
+  EXPECT_NEAR(pull({peak, 0, 0}).x, at_peak.x, 1e-12 * std::abs(at_peak.x));
+  // Beyond the peak the softening goes on along the envelope.
+  const double further = 0.75 * dnf;
+  EXPECT_NEAR(-pull({further, 0, 0}).x / S, envelope(further, dn0, dnf, sigma_n), 1e-9 * sigma_n);
+}
+
+// Work done on the link (trapezoids on a piecewise-linear force, with a node on every kink,
+// hence exact) equals its elastic energy plus what it dissipated, at every step of a cycle that
+// loads into softening, unloads to zero, reloads, and unloads again: nothing is created.
+TEST_F(CohesivePair, NoEnergyIsCreatedOverALoadUnloadCycle) {
+  std::vector<double> path;
+  const double h = dn0 / 8;
+  for (double u = 0; u < 40 * dn0; u += h) path.push_back(u);   // into softening
+  for (double u = 40 * dn0; u > 0; u -= h) path.push_back(u);   // unload
+  for (double u = 0; u < 60 * dn0; u += h) path.push_back(u);   // reload past the last peak
+  for (double u = 60 * dn0; u >= 0; u -= h) path.push_back(u);  // unload
+  double work = 0.0, u_prev = 0.0, f_prev = 0.0;
+  for (double u : path) {
+    const double f = -pull({u, 0, 0}).x;
+    work += 0.5 * (f + f_prev) * (u - u_prev);
+    u_prev = u, f_prev = f;
+    const double elastic = link->energy(p);
+    ASSERT_NEAR(work, elastic + dissipated(), 1e-9 * G_I * S) << "u = " << u;
+  }
+  EXPECT_NEAR(link->energy(p), 0.0, 1e-15);
+  EXPECT_GT(dissipated(), 0.0);
+}
+
+TEST_F(CohesivePair, CompressionIsAPenaltyContactEvenWhenDamaged) {
+  // Positions of size L carry a round-off of L eps, 1e-7 of the opening here.
+  const double u = -0.5 * dn0;
+  EXPECT_NEAR(-pull({u, 0, 0}).x, k * S * u, 1e-7 * k * S * dn0);  // pushes DE 1 back out
+  pull({0.5 * (dn0 + dnf), 0, 0});  // damage it
+  ASSERT_GT(damage(), 0.5);
+  EXPECT_NEAR(-pull({u, 0, 0}).x, k * S * u, 1e-7 * k * S * dn0);
+}
+
+// Turning the whole pair (centres and orientations) by 30 degrees about z opens nothing.
+TEST_F(CohesivePair, ARigidRotationOfThePairOpensNothing) {
+  const Quat q = from_rotation_vector({0, 0, std::numbers::pi / 6});
+  p.orientation[0] = p.orientation[1] = q;
+  p.position[1] = rotate(q, Vec3{L, 0, 0});
+  p.clear_forces();
+  link->accumulate_forces(p, criterion_scan());
+  EXPECT_LT(norm(p.force[1]), 1e-12 * sigma_n * S);
+  EXPECT_LT(norm(p.torque[1]), 1e-12 * sigma_n * S);
+}
+
+TEST_F(CohesivePair, APrecrackedLinkCarriesNoTension) {
+  p = ParticleSet{};
+  make(Region(Box{{0.5 * L - 1, -1, -1}, {0.5 * L + 1, 1, 1}}));
+  EXPECT_EQ(link->broken()[0], 1);
+  EXPECT_EQ(damage(), 1.0);
+  EXPECT_EQ(norm(pull({0.5 * dnf, 0, 0})), 0.0);
+  EXPECT_EQ(link->energy(p), 0.0);
+}
+
+TEST(CohesiveParameters, AreRefusedWhenTheSofteningOpeningIsNotBeyondTheElasticOne) {
+  CohesiveContactSet::Parameters q{sigma_n, sigma_s, G_I, G_II, k, 2.0, std::nullopt, 0.0};
+  EXPECT_NO_THROW(CohesiveContactSet{q});
+  q.stiffness = sigma_n * sigma_n / (2 * G_I) * 0.99;  // u_p^n just below sigma / k
+  try {
+    CohesiveContactSet{q};
+    FAIL() << "accepted u_p below the elastic opening";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("G_I: ", 0), 0u) << e.what();
+  }
+  q.stiffness = k;
+  q.toughness_I = 0.0;
+  EXPECT_THROW(CohesiveContactSet{q}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace arlequin::dem
