@@ -97,10 +97,11 @@ constexpr const char* usage_calibrate =
     "  --set applies to the sample case. Spec format: app/calibrate.hpp\n";
 
 constexpr const char* usage_sweep =
-    "usage: arlequin sweep CASE.yaml --over key.path=v1,v2,... [--over ...] [--out DIR] [--set k=v ...]\n"
+    "usage: arlequin sweep CASE.yaml --over key.path=v1,v2,... [--with key.path=w1,w2,...] [--over ...] [--out DIR] [--set k=v ...]\n"
     "  runs every combination of the --over values (results in DIR/<run>/, default\n"
     "  results/<name>_sweep/), prints a Markdown table of the case's checks (value, relative\n"
-    "  error) against wall time, and writes DIR/sweep.csv\n";
+    "  error) against wall time, and writes DIR/sweep.csv, sweep.png and sweep_time.png;\n"
+    "  --with values go one for one with the axis before it (w1 with v1, ...)\n";
 
 struct Arguments {
   std::string command;
@@ -142,8 +143,9 @@ Arguments parse(int argc, char** argv) {
       a.scene.overrides.push_back(arg.substr(6));
     } else if (arg == "--petsc") {
       a.scene.petsc_options += " " + value("a quoted PETSc option string");
-    } else if (arg == "--over" && a.command == "sweep") {
+    } else if ((arg == "--over" || arg == "--with") && a.command == "sweep") {
       a.axes.push_back(app::parse_sweep_axis(value("key.path=v1,v2,...")));
+      a.axes.back().with_previous = arg == "--with";
     } else if (arg == "--out" && (a.command == "run" || a.command == "sweep" || a.command == "compare" || a.command == "virtual-test" || a.command == "calibrate")) {
       a.scene.out_dir = value("a directory");
     } else if (arg == "--steps" && a.command == "run") {

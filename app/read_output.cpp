@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -39,9 +40,12 @@ constexpr KeyDoc check_keys[] = {
     {"crossing", KeyType::number, "column unit", {}, "(none)", "judge the time the column first reaches this value instead"},
     {"expected", KeyType::number, "(the column's, or s)", {}, "(none)", "reference value (with tolerance)"},
     {"tolerance", KeyType::number, "1", Range::positive(), "", "relative tolerance on expected"},
-    {"at_most", KeyType::number, "column unit", {}, "(none)", "upper bound (instead of expected)"},
-    {"at_least", KeyType::number, "column unit", {}, "(none)", "lower bound (instead of expected)"},
+    {"at_most", KeyType::number, "(column unit; 1 against a reference)", {}, "(none)", "upper bound (instead of expected)"},
+    {"at_least", KeyType::number, "(column unit; 1 against a reference)", {}, "(none)", "lower bound (instead of expected)"},
     {"note", KeyType::string, "", {}, "", "where the reference comes from, shown with the result"},
+    {"reference", KeyType::section, "", {}, "(none)", "a reference curve of the column against 'versus': the check is then the largest relative deviation"},
+    {"versus", KeyType::string, "", {}, "", "with reference: the column the reference curve is a function of"},
+    {"over", KeyType::numbers, "(versus unit)", {}, "(the reference's span)", "with reference: the range [low, high] of versus judged"},
 };
 constexpr KeyDoc output_keys[] = {
     {"dir", KeyType::string, "", {}, "(results/<name>)", "output folder, relative to the working directory"},
@@ -49,6 +53,11 @@ constexpr KeyDoc output_keys[] = {
     {"fields", KeyType::strings, "", {}, "[]", "field sets written to fields.h5: particles, bonds, continuum"},
     {"fields_every", KeyType::number, "s", Range::positive(), "(every)", "interval of fields.h5 frames"},
     {"plots", KeyType::list, "", {}, "(none)", "plots of series columns, drawn by the Python package"},
+};
+constexpr KeyDoc reference_keys[] = {
+    {"label", KeyType::string, "", {}, "reference", "legend text"},
+    {"x", KeyType::numbers, "(the x column's)", {}, "", "abscissae, increasing"},
+    {"y", KeyType::numbers, "(the y column's)", {}, "", "values at x"},
 };
 constexpr KeyDoc plot_keys[] = {
     {"file", KeyType::string, "", {}, "", "image name in the output folder: .png, .svg or .pdf"},
@@ -62,6 +71,7 @@ constexpr KeyDoc plot_keys[] = {
     {"y2", KeyType::strings, "", {}, "[]", "columns on the right axis"},
     {"y2_scale", KeyType::number, "1", {}, "1", "factor on the right axis' columns"},
     {"y2_label", KeyType::string, "", {}, "", "right axis label"},
+    {"references", KeyType::list, "", {}, "[]", "reference curves drawn on the left axis"},
 };
 
 constexpr SchemaSection output_sections[] = {
@@ -69,6 +79,8 @@ constexpr SchemaSection output_sections[] = {
     {"checks[]", "an acceptance check judged at time.end", check_keys},
     {"output", "results", output_keys},
     {"output.plots[]", "a plot of series columns", plot_keys},
+    {"output.plots[].references[]", "a reference curve of a plot", reference_keys},
+    {"checks[].reference", "a reference curve of a check", reference_keys},
 };
 
 }  // namespace
@@ -154,6 +166,27 @@ void read_sensors(CaseNode root, Scene& scene) {
   }
 }
 
+namespace {
+ReferenceCurve read_reference(CaseNode node) {
+  ReferenceCurve r;
+  r.label = node.string_or("label", "reference");
+  r.x = node.numbers("x", Range::any(), "(the x column's)");
+  r.y = node.numbers("y", Range::any(), "(the y column's)");
+  if (r.x.size() < 2 || r.x.size() != r.y.size()) node.fail("y", "expected as many values as x, two or more");
+  for (std::size_t k = 1; k < r.x.size(); ++k)
+    if (!(r.x[k] > r.x[k - 1])) node.fail("x", "expected increasing abscissae");
+  node.finish();
+  return r;
+}
+}  // namespace
+
+double ReferenceCurve::at(double xq) const {
+  if (!(xq >= x.front() && xq <= x.back())) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t k = std::max<std::size_t>(1, std::lower_bound(x.begin(), x.end(), xq) - x.begin());
+  const double w = (xq - x[k - 1]) / (x[k] - x[k - 1]);
+  return y[k - 1] + w * (y[k] - y[k - 1]);
+}
+
 void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& columns) {
   for (CaseNode c : root.list_or_empty("checks")) {
     Check check;
@@ -164,7 +197,19 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
       c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
     }
     static constexpr std::string_view statistics[] = {"final", "max", "min", "final_over_initial"};
-    if (c.has("crossing")) {
+    if (auto reference = c.child_if("reference")) {
+      check.kind = Check::Kind::curve;
+      check.reference = read_reference(*reference);
+      check.versus = c.string("versus");
+      if (std::find(columns.begin(), columns.end(), check.versus) == columns.end())
+        c.fail("versus", "no series column '" + check.versus + "'");
+      const auto over = c.has("over") ? c.numbers("over", Range::any(), "(versus unit)")
+                                      : std::vector<double>{check.reference.x.front(), check.reference.x.back()};
+      if (over.size() != 2 || !(over[0] < over[1]) || over[0] < check.reference.x.front() || over[1] > check.reference.x.back())
+        c.fail("over", "expected [low, high] within the reference curve's span");
+      check.over_low = over[0], check.over_high = over[1];
+      if (!c.has("at_most")) c.fail("at_most", "a check against a reference curve needs at_most, the largest relative deviation allowed");
+    } else if (c.has("crossing")) {
       check.kind = Check::Kind::crossing;
       check.threshold = c.number("crossing", Range::any(), "column unit");
     } else {
@@ -174,7 +219,7 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
                    : statistic == "min"  ? Check::Kind::minimum
                                          : Check::Kind::final_over_initial;
     }
-    const char* unit = check.kind == Check::Kind::crossing ? "s" : "column unit";
+    const char* unit = check.kind == Check::Kind::crossing ? "s" : check.kind == Check::Kind::curve ? "1" : "column unit";
     check.bounded = c.has("at_most") || c.has("at_least");
     if (check.bounded) {
       if (c.has("expected")) c.fail("expected", "give either expected and tolerance, or at_most / at_least");
@@ -263,6 +308,7 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
       plot.y2 = p.strings_or("y2", {});
       plot.y2_scale = p.number_or("y2_scale", 1.0, Range::any(), "1");
       plot.y2_label = p.string_or("y2_label", "");
+      for (CaseNode r : p.list_or_empty("references")) plot.references.push_back(read_reference(r));
       p.finish();
       plan.plots.push_back(plot);
     }

@@ -117,6 +117,14 @@ class Outputs {
       };
       for (const auto& y : plan.y) plot.curves.push_back(curve(y, plan.y_scale, false));
       for (const auto& y : plan.y2) plot.curves.push_back(curve(y, plan.y2_scale, true));
+      for (const auto& reference : plan.references) {
+        PlotCurve c;
+        c.label = reference.label;
+        c.style = PlotCurve::Style::dashed;
+        for (double x : reference.x) c.x.push_back(x * plan.x_scale);
+        for (double y : reference.y) c.y.push_back(y * plan.y_scale);
+        plot.curves.push_back(c);
+      }
     }
     arlequin::write_plots(scene_.output.dir, plots);
   }
@@ -248,6 +256,7 @@ const char* describe(Check::Kind kind) {
     case Check::Kind::minimum: return "minimum";
     case Check::Kind::final_over_initial: return "final / initial";
     case Check::Kind::crossing: return "crossing time";
+    case Check::Kind::curve: return "largest deviation from the reference";
   }
   return "";
 }
@@ -276,6 +285,21 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
         value = t0 + (t1 - t0) * a / (a - b);
         break;
       }
+    }
+    if (c.kind == Check::Kind::curve) {
+      const std::size_t versus = std::find(columns.begin(), columns.end(), c.versus) - columns.begin();
+      // A row that cannot be compared (a non-finite value) makes the check fail, as no row does.
+      bool compared = false, finite = true;
+      double worst = 0.0;
+      for (std::size_t r = 0; r < series.rows(); ++r) {
+        const double x = series.row(r)[versus];
+        if (!(x >= c.over_low && x <= c.over_high)) continue;
+        const double deviation = std::abs(series.row(r)[col] / c.reference.at(x) - 1.0);
+        compared = true;
+        finite = finite && std::isfinite(deviation);
+        worst = std::max(worst, deviation);
+      }
+      if (compared && finite) value = worst;
     }
     if (c.bounded) {
       out.push_back({&c, value, 0.0, value <= c.at_most && value >= c.at_least});

@@ -45,8 +45,16 @@ struct Sensor {
 // An acceptance check of the case against its reference, evaluated on series.csv after the run:
 // the final, largest or smallest value of a column, or the first time a column reaches a value
 // (a wave's arrival). Relative tolerance.
+// A reference curve y(x) given by points (x increasing), linear between them.
+struct ReferenceCurve {
+  std::string label;
+  std::vector<double> x, y;
+  double at(double xq) const;  // NaN outside [x.front(), x.back()]
+};
+
 struct Check {
-  enum class Kind { final_value, maximum, minimum, final_over_initial, crossing };
+  // curve: the largest |column / reference(versus) - 1| over the rows whose versus lies in over.
+  enum class Kind { final_value, maximum, minimum, final_over_initial, crossing, curve };
   std::string column;
   Kind kind = Kind::final_value;
   double threshold = 0.0;     // crossing: the value to reach
@@ -55,6 +63,9 @@ struct Check {
   double at_most = INFINITY, at_least = -INFINITY;
   bool bounded = false;       // true: passes when at_least <= value <= at_most
   std::string note;           // where the expected value comes from
+  std::string versus;         // curve: the column the reference is a function of
+  ReferenceCurve reference;   // curve
+  double over_low = 0.0, over_high = 0.0;  // curve: the range of versus judged
 };
 
 // A PNG plot of series.csv columns written at the end of a run (also a stopped one).
@@ -63,6 +74,7 @@ struct PlotPlan {
   std::string title, x, x_label, y_label, y2_label;
   double x_scale = 1.0, y_scale = 1.0, y2_scale = 1.0;  // multiply the columns (e.g. 1/L for strain)
   std::vector<std::string> y, y2;                       // left and right axes
+  std::vector<ReferenceCurve> references;               // dashed, left axis, in column units (scaled alike)
 };
 
 struct OutputPlan {

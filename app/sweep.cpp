@@ -40,7 +40,8 @@ SweepAxis parse_sweep_axis(const std::string& text) {
 namespace {
 
 // sweep.png: the first check's value against the first axis when its values are numbers (one
-// line per combination of the other axes), else against the wall time (one point per run).
+// line per combination of the other axes, axes going with another left out); sweep_time.png:
+// against the wall time, one point per run.
 void plot_sweep(const std::filesystem::path& dir, const std::vector<SweepAxis>& axes,
                 const std::vector<std::vector<std::string>>& picked, const std::vector<double>& value,
                 const std::vector<double>& wall, const std::string& check) {
@@ -51,30 +52,37 @@ void plot_sweep(const std::filesystem::path& dir, const std::vector<SweepAxis>& 
     first[r] = std::strtod(picked[r][0].c_str(), &end);
     numeric = numeric && end != picked[r][0].c_str() && *end == '\0';
   }
-  Plot spec;
-  spec.file = "sweep.png";
-  spec.title = "arlequin sweep: " + check;
-  spec.y_label = check + " (checked value)";
-  spec.x_label = numeric ? axes[0].key : "wall time (s)";
-  spec.log_y = std::all_of(value.begin(), value.end(), [](double v) { return v > 0.0; });
-  std::vector<std::string> labels;
-  for (std::size_t r = 0; r < picked.size(); ++r) {
-    std::string label;
-    for (std::size_t k = numeric ? 1 : 0; k < axes.size(); ++k)
-      label += (label.empty() ? "" : ", ") + axes[k].key.substr(axes[k].key.rfind('.') + 1) + "=" + picked[r][k];
-    auto it = std::find(labels.begin(), labels.end(), label);
-    if (it == labels.end()) {
-      labels.push_back(label);
-      PlotCurve& curve = spec.curves.emplace_back();
-      curve.label = label;
-      curve.style = numeric ? PlotCurve::Style::line_points : PlotCurve::Style::points;
-      it = labels.end() - 1;
+  const auto plot_against = [&](bool along_first_axis) {
+    Plot spec;
+    spec.file = along_first_axis ? "sweep.png" : "sweep_time.png";
+    spec.title = "arlequin sweep: " + check;
+    spec.y_label = check + " (checked value)";
+    spec.x_label = along_first_axis ? axes[0].key : "wall time (s)";
+    spec.log_y = std::all_of(value.begin(), value.end(), [](double v) { return v > 0.0; });
+    std::vector<std::string> labels;
+    for (std::size_t r = 0; r < picked.size(); ++r) {
+      std::string label;
+      for (std::size_t k = along_first_axis ? 1 : 0; k < axes.size(); ++k)
+        if (!along_first_axis || !axes[k].with_previous)
+          label += (label.empty() ? "" : ", ") + axes[k].key.substr(axes[k].key.rfind('.') + 1) + "=" + picked[r][k];
+      auto it = std::find(labels.begin(), labels.end(), label);
+      if (it == labels.end()) {
+        labels.push_back(label);
+        PlotCurve& curve = spec.curves.emplace_back();
+        curve.label = label;
+        curve.style = along_first_axis ? PlotCurve::Style::line_points : PlotCurve::Style::points;
+        it = labels.end() - 1;
+      }
+      PlotCurve& series = spec.curves[it - labels.begin()];
+      series.x.push_back(along_first_axis ? first[r] : wall[r]);
+      series.y.push_back(value[r]);
     }
-    PlotCurve& series = spec.curves[it - labels.begin()];
-    series.x.push_back(numeric ? first[r] : wall[r]);
-    series.y.push_back(value[r]);
-  }
-  write_plots(dir, {spec});
+    return spec;
+  };
+  std::vector<Plot> plots;
+  if (numeric) plots.push_back(plot_against(true));
+  plots.push_back(plot_against(false));
+  write_plots(dir, plots);
 }
 
 struct SweepRow {
@@ -136,7 +144,14 @@ std::pair<std::string, std::string> format_row(const SweepRow& row, std::size_t 
 bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base, const std::vector<SweepAxis>& axes,
                const std::filesystem::path& out_dir) {
   std::size_t runs = 1;
-  for (const auto& a : axes) runs *= a.values.size();
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    if (!axes[k].with_previous) {
+      runs *= axes[k].values.size();
+    } else if (k == 0 || axes[k].values.size() != axes[k - 1].values.size()) {
+      throw InputError("--with " + axes[k].key + ": expected as many values as the --over or --with before it" +
+                       (k == 0 ? std::string(" (there is none)") : " (" + std::to_string(axes[k - 1].values.size()) + ")"));
+    }
+  }
   std::vector<std::string> check_names;  // from the first scene built
   bool columns_known = false, header_printed = false;
   std::vector<SweepRow> rows;
@@ -175,9 +190,14 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
     SceneOptions options = base;
     options.out_dir = out_dir / std::to_string(run);
     SweepRow row;
-    for (std::size_t k = 0, rest = run; k < axes.size(); rest /= axes[k].values.size(), ++k) {
-      row.picked.push_back(axes[k].values[rest % axes[k].values.size()]);
-      options.overrides.push_back(Override(axes[k].key + "=" + row.picked.back(), "--over"));
+    std::size_t index = 0;
+    for (std::size_t k = 0, rest = run; k < axes.size(); ++k) {
+      if (!axes[k].with_previous) {
+        index = rest % axes[k].values.size();
+        rest /= axes[k].values.size();
+      }
+      row.picked.push_back(axes[k].values[index]);
+      options.overrides.push_back(Override(axes[k].key + "=" + row.picked.back(), axes[k].with_previous ? "--with" : "--over"));
     }
     const auto t0 = std::chrono::steady_clock::now();
     RunOptions run_options;
@@ -208,6 +228,8 @@ bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
     all_ok = all_ok && row.status == "ok";
     rows.push_back(std::move(row));
     print_rows(false);
+    // After every run, so that a long sweep stopped part way keeps the table of the runs done.
+    if (columns_known) write_table();
   }
   print_rows(true);
   write_table();

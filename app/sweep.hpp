@@ -14,6 +14,9 @@ namespace arlequin::app {
 struct SweepAxis {
   std::string key;                  // case key path, e.g. continuum.mesh.size
   std::vector<std::string> values;  // YAML texts
+  // --with: the values go with the previous axis's, one for one (a group that must follow a
+  // radius), instead of multiplying the runs.
+  bool with_previous = false;
 };
 
 // Parses "key=v1,v2,v3" (commas inside brackets belong to a value: "key=[1,2],[3,4]");
@@ -21,9 +24,11 @@ struct SweepAxis {
 SweepAxis parse_sweep_axis(const std::string& text);
 
 // Runs every combination into out_dir/<run index>/, prints a Markdown table on stdout and
-// writes out_dir/sweep.csv (atomically) and sweep.png: the first check's value against the
-// first axis if its values are numbers (a line per combination of the other axes), else
-// against the wall time. Returns false if any run failed or missed a check.
+// writes, after every run, out_dir/sweep.csv (atomically), sweep.png: the first check's value against the
+// first axis if its values are numbers (a line per combination of the other axes), and
+// sweep_time.png: that value against the wall time, a point per run. Returns false if any run
+// failed or missed a check. Throws InputError if a --with axis has no axis before it or not as
+// many values.
 bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
                const std::vector<SweepAxis>& axes, const std::filesystem::path& out_dir);
 

@@ -20,6 +20,7 @@ const char* style_name(PlotCurve::Style style) {
   switch (style) {
     case PlotCurve::Style::points: return "points";
     case PlotCurve::Style::line_points: return "line_points";
+    case PlotCurve::Style::dashed: return "dashed";
     case PlotCurve::Style::line: break;
   }
   return "line";

@@ -11,7 +11,7 @@
 namespace arlequin {
 
 struct PlotCurve {
-  enum class Style { line, points, line_points };
+  enum class Style { line, points, line_points, dashed };
 
   std::string label;  // legend text; empty: left out of the legend
   Style style = Style::line;

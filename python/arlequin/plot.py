@@ -25,6 +25,7 @@ STYLES = {
     "line": {"linestyle": "-"},
     "points": {"linestyle": "none", "marker": "o", "markersize": 3},
     "line_points": {"linestyle": "-", "marker": "o", "markersize": 3},
+    "dashed": {"linestyle": "--"},
 }
 FIGSIZE = (9.0, 5.6)  # inches; at DPI this is a 900 x 560 pixel PNG
 DPI = 100

@@ -192,15 +192,19 @@ TEST(Cli, SweepTabulatesErrorAgainstRunTime) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
+  // --with pairs its values with the axis before it: two runs, (0.5, fe) and (0.4, nem), not four.
   const auto out = test::scratch_dir("sweep");
-  const auto r = test::run_arlequin("sweep " + cases + "cantilever_continuum/case.yaml --over continuum.mesh.size=0.5,0.4 --out " +
-                                        out.string(), "stdout");
+  const auto r = test::run_arlequin("sweep " + cases + "cantilever_continuum/case.yaml --over continuum.mesh.size=0.5,0.4 "
+                                        "--with continuum.solver=fe,nem --out " + out.string(), "stdout");
   EXPECT_EQ(r.exit_code, 0) << r.output;
   const std::string csv = test::read_text(out / "sweep.csv");
-  EXPECT_NE(csv.find("continuum.mesh.size,particles,continuum_nodes,steps,tip_deflection,tip_deflection_relative_error,wall_seconds,status"),
+  EXPECT_NE(csv.find("continuum.mesh.size,continuum.solver,particles,continuum_nodes,steps,tip_deflection,"
+                     "tip_deflection_relative_error,wall_seconds,status\n0.5,fe,"),
             std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n0.4,nem,"), std::string::npos) << csv;
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
   EXPECT_TRUE(std::filesystem::exists(out / "sweep.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "sweep_time.png"));
 }
 
 // A swept box is one field of sweep.csv: quoted, so every row has the header's columns.
