@@ -40,8 +40,8 @@ SweepAxis parse_sweep_axis(const std::string& text) {
 namespace {
 
 // sweep.png: the first check's value against the first axis when its values are numbers (one
-// line per combination of the other axes, axes going with another left out); sweep_time.png:
-// against the wall time, one point per run.
+// line per combination of the other axes); sweep_time.png: against the wall time, one point
+// per run.
 void plot_sweep(const std::filesystem::path& dir, const std::vector<SweepAxis>& axes,
                 const std::vector<std::vector<std::string>>& picked, const std::vector<double>& value,
                 const std::vector<double>& wall, const std::string& check) {
@@ -62,8 +62,9 @@ void plot_sweep(const std::filesystem::path& dir, const std::vector<SweepAxis>& 
     std::vector<std::string> labels;
     for (std::size_t r = 0; r < picked.size(); ++r) {
       std::string label;
+      // Axes going with another are named by it (their values can be whole sections).
       for (std::size_t k = along_first_axis ? 1 : 0; k < axes.size(); ++k)
-        if (!along_first_axis || !axes[k].with_previous)
+        if (!axes[k].with_previous)
           label += (label.empty() ? "" : ", ") + axes[k].key.substr(axes[k].key.rfind('.') + 1) + "=" + picked[r][k];
       auto it = std::find(labels.begin(), labels.end(), label);
       if (it == labels.end()) {

@@ -85,9 +85,12 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
             dir_);
   read_case(cases + "dcb/case.yaml",
             {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
+             "groups=[{name: load_top, region: {box: [[-1, -1, 0.0015], [5.0e-4, 1, 1]]}}, "
+             "{name: load_bottom, region: {box: [[-1, -1, -1], [5.0e-4, 1, 0.0015]]}}]",
              "dem.interface.bond.sigma_max_shear=8.0e6", "dem.interface.bond.G_II=900", "dem.interface.bond.bk_exponent=1.5",
              "dem.contact={law: penalty, stiffness: 5.0e7, friction: 0.3, slip_velocity: 1.0e-3}",
-             "sensors=[{name: t, type: crack, bonds: interface, quantity: tip, axis: [1, 0, 0], across: [0, 1, 0], bins: 4}]"},
+             "sensors=[{name: P, type: force, group: load_top, component: z}, {name: Delta, type: displacement, group: load_top, "
+             "component: z}, {name: t, type: crack, bonds: interface, quantity: tip, axis: [1, 0, 0], across: [0, 1, 0], bins: 4}]"},
             dir_);
   read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
   read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
