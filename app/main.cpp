@@ -180,9 +180,9 @@ Arguments parse(int argc, char** argv) {
 // The registries' rows: each law's case-file name and one-line summary.
 int list_laws() {
   std::printf("bond laws (dem.material.bond.law):\n");
-  for (const auto& law : dem::bond_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  for (const auto& law : dem::bond_laws()) std::printf("  %-17s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
   std::printf("contact laws (dem.contact.law):\n");
-  for (const auto& law : dem::contact_laws()) std::printf("  %-8s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  for (const auto& law : dem::contact_laws()) std::printf("  %-17s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
   return 0;
 }
 

@@ -10,7 +10,7 @@ namespace arlequin::dem {
 
 std::span<const ContactLawEntry> contact_laws() {
   static const ContactLawEntry table[] = {
-      {"penalty", "linear penalty normal contact (seed Eq. 9): stiffness", &PenaltyContact::make, &PenaltyContact::keys},
+      {"penalty", "linear penalty contact (seed Eq. 9), regularised Coulomb friction: stiffness, friction", &PenaltyContact::make, &PenaltyContact::keys},
   };
   return table;
 }

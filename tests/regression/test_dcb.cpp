@@ -210,12 +210,12 @@ TEST(Dcb, ReducedDcbPropagatesAlongLefmAndBalancesEnergy) {
   EXPECT_LT(mix / breaks.size(), 0.45);  // opening-dominated: measured 0.33 (the arms' rotation slides the faces)
 }
 
-// The 40k-DE DCB of the case file, to Delta = 2.5 mm: R5's gates.
+// The 40k-DE DCB of the case file, to Delta = 2.5 mm: R5's gates as restated (docs/decisions.md#d28).
 TEST(ValidationDcb, Dcb40kMatchesR5) {
   const auto out = test::scratch_dir("dcb_40k");
   const auto r = test::run_arlequin("run " + dcb_case + " --quiet --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const DcbFigures f = evaluate(out / "series.csv", 0.5e-3, 2.0e-3);
+  const DcbFigures f = evaluate(out / "series.csv", 0.75e-3, 2.0e-3);
   EXPECT_LT(f.worst_load_error, 0.10);
   EXPECT_NEAR(f.peak / reference_peak, 1.0, 0.10);
   EXPECT_NEAR(f.growth_energy_ratio, 1.0, 0.10);
