@@ -179,10 +179,16 @@ Arguments parse(int argc, char** argv) {
 
 // The registries' rows: each law's case-file name and one-line summary.
 int list_laws() {
+  std::size_t width = 0;  // of the longest name, so the summaries line up
+  for (const auto& law : dem::bond_laws()) width = std::max(width, law.name.size());
+  for (const auto& law : dem::contact_laws()) width = std::max(width, law.name.size());
+  const auto row = [&](std::string_view name, std::string_view summary) {
+    std::printf("  %-*s %s\n", int(width), std::string(name).c_str(), std::string(summary).c_str());
+  };
   std::printf("bond laws (dem.material.bond.law):\n");
-  for (const auto& law : dem::bond_laws()) std::printf("  %-17s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  for (const auto& law : dem::bond_laws()) row(law.name, law.summary);
   std::printf("contact laws (dem.contact.law):\n");
-  for (const auto& law : dem::contact_laws()) std::printf("  %-17s %s\n", std::string(law.name).c_str(), std::string(law.summary).c_str());
+  for (const auto& law : dem::contact_laws()) row(law.name, law.summary);
   return 0;
 }
 

@@ -2,9 +2,9 @@
 #include "app/scene_readers.hpp"
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 

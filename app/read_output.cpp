@@ -131,8 +131,9 @@ void read_sensors(CaseNode root, Scene& scene) {
       const auto& set = *sets[sensor.crack.bond_set];
       sensor.crack.initial_tip = dem::measure_crack(set, scene.dem.particles, sensor.crack.axis, sensor.crack.across,
                                                     sensor.crack.bins).tip;
-      if (std::isnan(sensor.crack.initial_tip) && sensor.crack.quantity != Sensor::CrackQuantity::tip &&
-          sensor.crack.quantity != Sensor::CrackQuantity::damage_front && sensor.crack.quantity != Sensor::CrackQuantity::dissipated)
+      const bool from_initial_tip = sensor.crack.quantity == Sensor::CrackQuantity::crack_growth ||
+                                    sensor.crack.quantity == Sensor::CrackQuantity::softening_zone;
+      if (from_initial_tip && std::isnan(sensor.crack.initial_tip))
         s.fail("quantity", "lengths from the initial tip need links that start failed (a pre-crack)");
       s.finish();
       scene.sensors.push_back(sensor);
@@ -190,19 +191,22 @@ double ReferenceCurve::at(double xq) const {
 void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& columns) {
   for (CaseNode c : root.list_or_empty("checks")) {
     Check check;
-    check.column = c.string("column");
-    if (std::find(columns.begin(), columns.end(), check.column) == columns.end()) {
-      std::string known;
-      for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
-      c.fail("column", "no series column '" + check.column + "' (columns: " + known + ")");
-    }
+    // The name under `key`, which must be a series column.
+    const auto series_column = [&](const char* key) {
+      std::string name = c.string(key);
+      if (std::find(columns.begin(), columns.end(), name) == columns.end()) {
+        std::string known;
+        for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
+        c.fail(key, "no series column '" + name + "' (columns: " + known + ")");
+      }
+      return name;
+    };
+    check.column = series_column("column");
     static constexpr std::string_view statistics[] = {"final", "max", "min", "final_over_initial"};
     if (auto reference = c.child_if("reference")) {
       check.kind = Check::Kind::curve;
       check.reference = read_reference(*reference);
-      check.versus = c.string("versus");
-      if (std::find(columns.begin(), columns.end(), check.versus) == columns.end())
-        c.fail("versus", "no series column '" + check.versus + "'");
+      check.versus = series_column("versus");
       const auto over = c.has("over") ? c.numbers("over", Range::any(), "(versus unit)")
                                       : std::vector<double>{check.reference.x.front(), check.reference.x.back()};
       if (over.size() != 2 || !(over[0] < over[1]) || over[0] < check.reference.x.front() || over[1] > check.reference.x.back())

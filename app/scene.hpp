@@ -42,9 +42,6 @@ struct Sensor {
   } crack;
 };
 
-// An acceptance check of the case against its reference, evaluated on series.csv after the run:
-// the final, largest or smallest value of a column, or the first time a column reaches a value
-// (a wave's arrival). Relative tolerance.
 // A reference curve y(x) given by points (x increasing), linear between them.
 struct ReferenceCurve {
   std::string label;
@@ -52,6 +49,9 @@ struct ReferenceCurve {
   double at(double xq) const;  // NaN outside [x.front(), x.back()]
 };
 
+// An acceptance check of the case against its reference, evaluated on series.csv after the run:
+// the final, largest or smallest value of a column, or the first time a column reaches a value
+// (a wave's arrival). Relative tolerance.
 struct Check {
   // curve: the largest |column / reference(versus) - 1| over the rows whose versus lies in over.
   enum class Kind { final_value, maximum, minimum, final_over_initial, crossing, curve };

@@ -24,11 +24,11 @@ struct SweepAxis {
 SweepAxis parse_sweep_axis(const std::string& text);
 
 // Runs every combination into out_dir/<run index>/, prints a Markdown table on stdout and
-// writes, after every run, out_dir/sweep.csv (atomically), sweep.png: the first check's value against the
-// first axis if its values are numbers (a line per combination of the other axes), and
-// sweep_time.png: that value against the wall time, a point per run. Returns false if any run
-// failed or missed a check. Throws InputError if a --with axis has no axis before it or not as
-// many values.
+// writes, after every run, out_dir/sweep.csv (atomically), sweep.png (the first check's value
+// against the first axis if its values are numbers, a line per combination of the other axes)
+// and sweep_time.png (that value against the wall time, a point per run). Returns false if any
+// run failed or missed a check. Throws InputError if a --with axis has no axis before it or not
+// as many values.
 bool run_sweep(const std::filesystem::path& case_file, const SceneOptions& base,
                const std::vector<SweepAxis>& axes, const std::filesystem::path& out_dir);
 

@@ -2,9 +2,9 @@
 //
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually
 // touching (|x_i - x_j| < R_i + R_j) and returns the power its friction dissipates at the
-// present velocities (W, >= 0; 0 for a frictionless law); energy() is the elastic energy of those contacts;
-// stiffness() is the largest normal stiffness a contact can have (N/m), for the critical
-// time step. One virtual call per batch of pairs, none per pair.
+// present velocities (W, >= 0; 0 for a frictionless law); energy() is the elastic energy of
+// those contacts; stiffness() is the largest normal stiffness a contact can have (N/m), for the
+// critical time step. One virtual call per batch of pairs, none per pair.
 #pragma once
 #include <memory>
 #include <span>

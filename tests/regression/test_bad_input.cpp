@@ -42,6 +42,20 @@ struct BadInput {
 
 std::ostream& operator<<(std::ostream& os, const BadInput& b) { return os << b.name; }
 
+// Lines 6-7 of a case whose chain is two materials (DEs 0 and 1 in `a`, the box, DE 2 in `b`)
+// joined by a cohesive interface with these parameters; line 4 (one density) becomes no_density.
+std::string cohesive_interface(const std::string& parameters, const std::string& box = "[[-1, -1, -1], [0.003, 1, 1]]") {
+  // Appended piece by piece: GCC 12 warns falsely of overlapping copies in "..." + s + "...".
+  std::string lines = "  materials: {a: {density: 7800, region: {box: ";
+  lines += box;
+  lines += "}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
+           "  interface: {bond: {law: cohesive_bilinear, ";
+  lines += parameters;
+  lines += "}}";
+  return lines;
+}
+const std::string no_density = "  # density: per material";
+
 class BadInputTest : public ::testing::TestWithParam<BadInput> {};
 
 TEST_P(BadInputTest, OneLineErrorNamingWhereAndNonZeroExit) {
@@ -113,32 +127,18 @@ INSTANTIATE_TEST_SUITE_P(
                  {"case.yaml:2", "time.end", "no step would run"}},
         BadInput{"misspelt_required_key", 6, "  bond: {law: beam, E_m: 2.0e11, r_mu: 0.5}", "",
                  {"case.yaml:6", "missing required key 'E_mu'", "is 'E_m' (line 6) a misspelling of 'E_mu'?"}},
-        // The cohesive interface of two materials (the chain's DEs 0, 1 and 2 split at x = 3 mm).
-        BadInput{"cohesive_strength_not_positive", 6,
-                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
-                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
-                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: -5.7e6, G_I: 560, stiffness: 1.0e15}}", "",
-                 {"case.yaml:7", "dem.interface.bond.sigma_max", "> 0"}, 4, "  # density: per material"},
-        BadInput{"cohesive_toughness_not_positive", 6,
-                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
-                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
-                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 0, stiffness: 1.0e15}}", "",
-                 {"case.yaml:7", "dem.interface.bond.G_I", "> 0"}, 4, "  # density: per material"},
-        BadInput{"cohesive_u_p_below_elastic_opening", 6,
-                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
-                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
-                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e4}}", "",
-                 {"case.yaml:7", "dem.interface.bond.G_I", "not beyond the elastic opening"}, 4, "  # density: per material"},
+        BadInput{"cohesive_strength_not_positive", 6, cohesive_interface("sigma_max: -5.7e6, G_I: 560, stiffness: 1.0e15"), "",
+                 {"case.yaml:7", "dem.interface.bond.sigma_max", "> 0"}, 4, no_density},
+        BadInput{"cohesive_toughness_not_positive", 6, cohesive_interface("sigma_max: 5.7e6, G_I: 0, stiffness: 1.0e15"), "",
+                 {"case.yaml:7", "dem.interface.bond.G_I", "> 0"}, 4, no_density},
+        BadInput{"cohesive_u_p_below_elastic_opening", 6, cohesive_interface("sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e4"), "",
+                 {"case.yaml:7", "dem.interface.bond.G_I", "not beyond the elastic opening"}, 4, no_density},
         BadInput{"cohesive_interface_crossed_by_no_pair", 6,
-                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [1, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
-                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
-                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15}}", "",
-                 {"case.yaml:", "dem.interface.bond.law", "no pair of DEs"}, 4, "  # density: per material"},
+                 cohesive_interface("sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15", "[[-1, -1, -1], [1, 1, 1]]"), "",
+                 {"case.yaml:", "dem.interface.bond.law", "no pair of DEs"}, 4, no_density},
         BadInput{"cohesive_precrack_longer_than_specimen", 6,
-                 "  materials: {a: {density: 7800, region: {box: [[-1, -1, -1], [0.003, 1, 1]]}, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}, "
-                 "b: {density: 7800, bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}}}\n"
-                 "  interface: {bond: {law: cohesive_bilinear, sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15, precrack: {box: [[-1, -1, -1], [1, 1, 1]]}}}", "",
-                 {"case.yaml:", "dem.interface.bond.precrack", "as long as the specimen"}, 4, "  # density: per material"},
+                 cohesive_interface("sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15, precrack: {box: [[-1, -1, -1], [1, 1, 1]]}"), "",
+                 {"case.yaml:", "dem.interface.bond.precrack", "as long as the specimen"}, 4, no_density},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),
