@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Calibration of beam-bond micro parameters (E_mu, r_mu) against macroscopic elastic targets
 // (E_M, nu_M) with quasi-static virtual tensile tests (docs/theory.md#calibration; seed Table 1,
 // docs/validation.md R2; docs/references.md#andre2012, section 4):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `arlequin compare`: runs two cases that share sensors (e.g. pure DEM and coupled) and
 // reports, for each shared sensor column, the second run's difference to the first (the
 // reference) against both runs' run times and sizes: the user's "error against run time" view.

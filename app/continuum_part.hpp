@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The scene's continuum, read from the case file's `continuum:` section: the solver chosen by
 // name from the registry (fe, nem), its mesh, material, boundary conditions and analysis.
 // The one adapter between the application and continuum/ and coupling/: its header names no

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ContinuumPart for builds configured with ARLEQUIN_WITH_CONTINUUM=OFF: a case that asks for a
 // continuum gets a clear error instead of a link failure.
 #include "app/continuum_part.hpp"

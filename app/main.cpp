@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The `arlequin` command line: run and check case files.
 #include <unistd.h>
 

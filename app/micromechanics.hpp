@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Closed-form elastic moduli of a unidirectional fibre composite with isotropic phases: the
 // "theory" row of docs/validation.md R3 (seed Table 3), against which DEM REV tests are judged.
 //

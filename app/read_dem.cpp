@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The dem section of a case: sample, bonds, materials, contact, damping, failure (and their keys).
 #include "app/scene_readers.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The loading of a case: groups, boundary conditions, initial velocities, pulse, initial strain (and their keys).
 #include "app/scene_readers.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What a case measures and writes: sensors, checks, output folder, rows, fields, plots (and their keys).
 #include "app/scene_readers.hpp"
 

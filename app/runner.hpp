@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Runs a scene to its end time: the time loop, outputs (series.csv, fields.h5/.xdmf,
 // summary.json in the output folder, each written atomically), progress and health checks.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // build_scene: a case file read section by section (scene_readers.hpp), then the time step.
 #include "app/scene.hpp"
 

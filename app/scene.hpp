@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A scene: everything a run needs, built from a case file with only the parts the case uses
 // (no contact search without a contact law, no HDF5 file without field output, no PETSc
 // without a continuum).

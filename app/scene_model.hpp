@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What a run advances: the DEM alone, the continuum alone, both side by side, or both coupled
 // by the Arlequin method, behind one interface that build_scene chooses once. The runner's loop is
 // model.step(dt); rows read energies() and monitor(), frames write_fields().

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The readers of a case file's sections, one file per part (used by build_scene only):
 // read_dem.cpp (the dem section), read_loading.cpp (groups, boundary, initial, pulse,
 // initial_strain), read_output.cpp (sensors, checks, output). Each declares its keys beside its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `arlequin sweep`: runs one case over the Cartesian product of overridden values and tabulates,
 // per run, the case's checks (value, relative error) against the wall time: the user's
 // "error against run time" view of a discretisation or solver choice.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Small text helpers shared by the app's tools (calibrate, virtual tests): a number printed
 // with a printf pattern, the names of the coordinate axes as case files spell them, broken
 // fractions per bond set.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Quasi-static virtual material tests on a DEM sample: tension and simple shear of a box-shaped
 // sample, the seed's "first challenge" (homogenised moduli of a REV, seed Fig. 3 and Table 3;
 // docs/validation.md R2, R3), and the suites of them that `arlequin virtual-test` runs.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bonded-block benchmark (docs/validation.md R9): the case cases/bonded_block_tension (20 x 20 x 50
 // spheres, ~57 600 beam bonds, bottom fixed, top pulled at 0.1 m/s, dt = 1e-7 s), 2000 steps
 // with no output, for 1 and 2 OpenMP threads. Prints setup time, step time, particle-steps/s,

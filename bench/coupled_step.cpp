@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Coupled-step benchmark: the explicit step of an Arlequin-coupled case (default
 // cases/wave_bar_coupled: DEM quarter, P1 continuum, linear weights, coarse mediator), without
 // output. Prints the time per step and the heap allocations per step made by our code (the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The cost of entering OpenMP for a loop too small for threads (common/parallel.hpp,
 // run_threaded_if): a parallel region whose `if` clause is false still starts a team of one;
 // an orphaned `omp for` outside any region runs in the calling thread. Prints ns per call of

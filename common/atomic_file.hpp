@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Whole-file writes that readers never see half done: outputs are re-written while a run
 // is going (CSV series, XDMF index, summaries) and may be opened by a viewer or a script
 // at any moment, or left behind by a killed run.

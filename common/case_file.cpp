@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "common/case_file.hpp"
 #include "common/schema.hpp"
 

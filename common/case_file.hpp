@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Case files: the user's YAML description of a simulation, read through a strict schema.
 //
 // Readers pull values through CaseNode accessors that state the type, allowed range and unit

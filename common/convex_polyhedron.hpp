@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Convex polyhedra by their faces, clipped by half-spaces: Voronoi cells (continuum/nem) and
 // Laguerre (power) cells (dem RDEF volume shares) are a box cut by one plane per neighbour.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Time series table (one row per output step) written as CSV. Rows stay in memory and the
 // whole file is rewritten atomically, so the file on disk is always a complete table that
 // plotting scripts can read while the run goes on.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Errors the user can act on. A message names where the problem is (file, line, key) and
 // what was expected; the application turns them into one line on stderr and a non-zero exit.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "common/fields_writer.hpp"
 
 #include <hdf5.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Field output for ParaView: heavy data in one HDF5 file, an XDMF 3 index describing a time
 // series of frames, each frame a spatial collection of named unstructured grids.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Owner of one HDF5 id, released with its matching close function (H5Fclose, H5Dclose, ...).
 // Internal to the .cpp files that talk to HDF5 (hdf5.h pulls in mpi.h: keep it out of headers
 // that others include).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Stopping a run by hand (Ctrl-C, or SIGTERM from a batch system) without losing what it wrote.
 //
 // Contract: while an InterruptScope lives, the first SIGINT or SIGTERM only records the signal

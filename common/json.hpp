@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // JSON documents (run summaries, reports, caches) through nlohmann-json. Object keys keep
 // insertion order so that summaries diff cleanly between runs; non-finite numbers are written
 // as null, since JSON has no representation for them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared by the OpenMP loops of the DEM and the continuum (built with ARLEQUIN_WITH_OPENMP;
 // without it the pragmas are ignored and every loop runs on one thread).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Plots of a run's results: the program says what to draw (plots.json in the results folder),
 // the Python package python/arlequin draws it with matplotlib (`python3 -m arlequin.plot DIR`,
 // usable on its own). Curves either name columns of a CSV file in that folder (series.csv,

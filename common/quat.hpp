@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Unit quaternion for rigid rotations: q = (w, v), rotation R(q) x = q x q*.
 #pragma once
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Regions of space used to name groups of DEs, material zones and overlap zones.
 //
 // A region mapping has one key naming its shape (box, cylinder, sphere, half_space: the schema

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Lookup in an explicit registry table (bond laws, contact laws, continuum solvers...): the
 // case file names an entry; an unknown name is a case-file error listing the valid ones.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The case-file schema: every key a reader asks for, declared once beside that reader (name,
 // type, unit, range, default, help), and checked on every read.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Small fixed-size vector and its inline algebra. Plain aggregate so arrays of Vec3 are
 // contiguous (3 doubles each) and the compiler vectorises loops over them.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "continuum/block_matrix.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // BlockMatrix3: a sparse matrix of 3x3 blocks in compressed block rows (one block row per node,
 // one block per pair of coupled nodes): the assembled stiffness K of the explicit solvers.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ContinuumSolver: one linear-elastic continuum on a gmsh mesh, discretised by a named method
 // (see registry.hpp). Everything the coupling and the application use is here; a method only
 // supplies its integration points, its lumped mass and its interpolation.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Material: linear elastic stiffness in Voigt form and density.
 // Voigt order (xx, yy, zz, yz, xz, xy) with engineering shear strains (gamma = 2 eps), so
 // sigma = C eps and the strain energy density is eps.C.eps / 2.

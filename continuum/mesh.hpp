@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh: a tetrahedral mesh with named physical groups, read or generated through the gmsh C++ API.
 // Contract:
 //  - `Mesh::load` meshes a .geo file in-process (element size `size`, order 1 or 2) or reads a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // PetscSession: PETSc is started on the first call that needs it and finalised at program exit.
 // Contract: `ensure(options)` may be called any number of times from the thread that builds
 // continua; the first call runs PetscInitialize (MPI included) with `options` (a PETSc option

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Registry of continuum discretisations, keyed by the name the case file uses.
 // Adding a method = one .hpp/.cpp pair deriving from ContinuumSolver + one row in registry.cpp.
 #pragma once

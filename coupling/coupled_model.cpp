@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "coupling/coupled_model.hpp"
 
 #include <algorithm>

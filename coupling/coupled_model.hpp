@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // CoupledModel: a DEM model and a continuum coupled by the Arlequin method with velocity
 // multipliers, advanced by one explicit velocity-Verlet step (docs/theory.md#coupled-step).
 //

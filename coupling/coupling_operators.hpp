@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // CouplingOperators: the discrete Arlequin constraint G_d u_d + G_c u_c = 0 between the DE
 // translations and the continuum displacements in the overlap.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MultiplierSolver: the Lagrange-multiplier system of the velocity constraint, factored once.
 //
 // Contract

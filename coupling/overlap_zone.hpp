@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // OverlapZone: where the DEM and the continuum coexist, and the Arlequin weights there.
 //
 // Contract

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // PetscSpdSolver: a sparse symmetric positive definite system solved by PETSc's KSP, chosen and
 // tuned at run time by an option string (the coupling's multiplier system; MultiplierSolver).
 //

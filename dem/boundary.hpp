@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Boundary conditions on groups of DEs, applied from t = 0.
 //
 //   fixed         x = x_ref, v = 0, rotation locked (clamped)

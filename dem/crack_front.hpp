@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Where an interface has failed: the crack tip and the damage front of a bond set with a damage
 // variable (cohesive links) or broken flags, measured along a direction and averaged across
 // the width (docs/theory.md#crack-measures).

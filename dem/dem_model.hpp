@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The DEM model: particles, bond batches, optional contact, boundary conditions, and the
 // explicit velocity-Verlet step with rotations (docs/theory.md#step).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "dem/failure.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bond failure: events, the virial stress of a DE, and the RDEF criterion.
 //
 // BBF (breakable bond): each bond law judges its own bonds (beam: maximal normal stress,

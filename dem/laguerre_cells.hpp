@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Laguerre (power) cells of a set of spheres: cell i holds the points x with
 //   |x - c_i|^2 - R_i^2 <= |x - c_j|^2 - R_j^2   for every j,
 // bounded by the radical planes 2 (c_j - c_i).x = |c_j|^2 - |c_i|^2 - R_j^2 + R_i^2, and here by

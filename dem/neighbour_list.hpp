@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Verlet list of candidate contact pairs, built from a cell list with a skin.
 //
 // Contract: after build(), pairs() holds every pair i < j, not excluded, whose surfaces are

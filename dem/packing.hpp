@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Dense random packings of spherical DEs in a region: the seed's "first challenge"
 // (docs/theory.md#packing). Radii follow a truncated Gaussian; as many DEs as the target
 // compaction needs are inserted at random at reduced size, then grown to full size in steps

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Spherical discrete elements in structure-of-arrays form.
 //
 // Contract: every array has size(); index i is one DE for the whole run (once bonds or groups

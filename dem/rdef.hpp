@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // RDEF, the virial-stress element failure criterion (failure.hpp, docs/theory.md#rdef): every
 // bond of a DE breaks when the equivalent stress of its virial stress reaches the DE's
 // threshold; Omega_i = sphere volume / compaction, or the DE's Laguerre cell (`volume`,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "dem/sample_file.hpp"
 
 #include <hdf5.h>

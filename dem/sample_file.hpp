@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sample files: a packed sample's DEs and how it was built, in HDF5, so that a long packing
 // is built once and the runs that use it start from identical DEs.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sample builders: regular arrangements of DEs and bonding by proximity.
 // (Random dense packings come with the composite REV work.)
 #pragma once

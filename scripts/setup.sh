@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Shared by run.sh and test.sh: install the Debian packages if any is missing (needs root:
 # apt-get install), then configure and build into build/.
 # The list is everything a bare Debian 12 lacks for the build and the tests: the compiler and a
@@ -8,7 +9,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 packages=(g++ make cmake pkg-config libeigen3-dev petsc-dev openmpi-bin libcgal-dev
-          libgmsh-dev gmsh libhdf5-dev libgtest-dev libbenchmark-dev libyaml-cpp-dev nlohmann-json3-dev
+          libgmsh-dev gmsh libhdf5-dev libgtest-dev libyaml-cpp-dev nlohmann-json3-dev
           python3 python3-matplotlib python3-numpy python3-pandas python3-h5py python3-pytest)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // FeSolver ("fe"): Lagrange tetrahedra, linear (4 nodes) or quadratic (10 nodes) from the mesh
 // order, straight-sided (affine geometry).
 // Integration: P1 one point (exact, constant strain); P2 the symmetric 4-point degree-2 rule,

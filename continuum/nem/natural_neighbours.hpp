@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Natural-neighbour coordinates (Sibson and Laplace) in 3D and on a plane, computed in an order
 // fixed by the node numbers, so that the same query on the same nodes gives the same bits in any
 // build of the triangulation.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "continuum/nem/nem_solver.hpp"
 
 #include <CGAL/AABB_traits.h>

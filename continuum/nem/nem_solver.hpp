@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // NemSolver ("nem"): natural element method in the spirit of CNEM, on the nodes of the mesh.
 // - Shape functions: Sibson or Laplace natural-neighbour coordinates of the 3D Delaunay
 //   tessellation of the nodes (CGAL::Delaunay_triangulation_3; the coordinates are ours,

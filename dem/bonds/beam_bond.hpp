@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Cohesive Euler-Bernoulli beam bond (law name "beam").
 //
 // Reference: D. Andre, I. Iordanoff, J.-L. Charles, J. Neauport, "Discrete element method to

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The bookkeeping every bond law shares, written once: a law is a kernel that evaluates one
 // bond, and BondKernelSet<Law> turns it into a BondSet (force pass with its failure, energy and
 // virial records, energies, virial, failure events, stiffness scaling and bounds, colouring).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The explicit registry of bond laws: one row per law, keyed by its case-file name.
 // To add a law: (1) write dem/bonds/NAME_bond.hpp/.cpp, a class deriving from
 // BondKernelSet<Class> with the kernel listed in bond_kernel_set.hpp, a static make(section)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "dem/bonds/bond_set.hpp"
 
 #include <algorithm>

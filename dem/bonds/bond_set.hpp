@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A batch of bonds of one law and one material: the unit of work for bond forces.
 //
 // Contract: add() records a bond in the current configuration, which becomes its stress-free

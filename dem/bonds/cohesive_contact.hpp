@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bilinear cohesive contact (law name "cohesive_bilinear"): the seed's contact softening model
 // (its Eq. 2) between DEs across an interface, with mixed mode after Camanho and Davila.
 // Equations, derivations and references: docs/theory.md#cohesive-contact.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Breakable-yarn spring bond (law name "spring"), seed Eq. 6.
 //
 //   F_j = -K (|d| - L0) n,  d = x_j - x_i,  n = d / |d|,  F_i = -F_j;  energy K (|d|-L0)^2 / 2.

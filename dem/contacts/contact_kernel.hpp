@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The pair loop every contact law shares, written once: a law is a kernel that gives the force
 // and the energy of two touching spheres, and ContactKernelLaw<Law> turns it into a ContactLaw.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Contact laws act on the pairs of a NeighbourList.
 //
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually

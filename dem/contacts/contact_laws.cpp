@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The explicit registry of contact laws: one row per law, keyed by its case-file name.
 // To add a law: (1) write dem/contacts/NAME_contact.hpp/.cpp, a class deriving from
 // ContactKernelLaw<Class> with the kernel listed in contact_kernel.hpp, a static make(section)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Linear penalty contact (law name "penalty"), seed Eq. 9.
 //
 //   overlap delta = R_i + R_j - |x_j - x_i| > 0,  n = (x_j - x_i)/|x_j - x_i|

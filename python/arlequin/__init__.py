@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Python side of arlequin: read a run's results folder and draw its plots.
 
 `arlequin.load(path)` gives the run's tables and fields; `python3 -m arlequin.plot DIR`

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Draws the plots that a run describes in its plots.json, with matplotlib.
 
     python3 -m arlequin.plot RESULTS_DIR [--format png,svg,pdf] [--only FILE ...]

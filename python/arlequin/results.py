@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Reading a results folder written by the arlequin C++ program into pandas, dicts and h5py.
 
     import arlequin

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Shared helpers for the tests: a synthetic results folder and running the plot command."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Tests of arlequin.plot: the plots.json contract, the drawn data and the command line."""
 
 import math

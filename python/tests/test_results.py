@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Tests of arlequin.load: reading series, breaks, summary, other CSVs and fields.h5."""
 
 import json

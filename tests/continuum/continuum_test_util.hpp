@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared set-up for the continuum tests: mesh paths, settings, affine fields, patch tests.
 #pragma once
 #include <gtest/gtest.h>

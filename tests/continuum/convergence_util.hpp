@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Exact elastic fields and error norms shared by the convergence and cantilever tests.
 #pragma once
 #include <cmath>

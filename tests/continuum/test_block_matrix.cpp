@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // BlockMatrix3 against a dense product: random point matrices added over overlapping node lists
 // (as the stiffness assembly does), then y = K x against the dense K built from the same
 // contributions; a block outside the pattern is refused; and a matrix large enough for threads

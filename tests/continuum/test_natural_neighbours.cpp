@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Our natural-neighbour coordinates (continuum/nem/natural_neighbours.hpp) against CGAL's, an
 // independent implementation of the same definitions; against linear reproduction where CGAL
 // has none (Laplace in 2D); and their bits against the insertion order of the triangulation.

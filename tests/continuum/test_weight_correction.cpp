@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ContinuumSolver::correct_weights (the Arlequin overlap's consistent quadrature,
 // coupling/coupled_model.hpp): the weighted gradient sums g_a = sum_q w_q grad_q N_a meet their targets,
 // the weights stay positive, and nothing outside alpha < 1 moves.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared set-ups for the coupling tests: structured box meshes written as gmsh files, and
 // DEM bars that match them (same stiffness per unit length and mass per node).
 #pragma once

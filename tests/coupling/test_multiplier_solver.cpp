@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // MultiplierSolver on hand-built operators: the projection onto ker G against its closed form,
 // and a row whose dofs are all held (empty row, multiplier 0) beside rows that are not; with
 // each backend (our LDL^T, PETSc's direct and an iterative PETSc solve).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Overlap zone and weight functions: alpha_d + alpha_c = 1, shapes across the ramp, membership.
 #include <gtest/gtest.h>
 

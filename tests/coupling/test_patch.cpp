@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Static patch tests of the coupling (docs/validation.md R6): the coupling operators see no mismatch in
 // an affine field, and a coupled model started on a uniform strain stays on it (no spurious
 // forces in the overlap).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Dynamic transmission through the overlap (docs/validation.md R6): a tone burst sent from the DEM
 // side; R = energy left in the DEM after the pulse has passed / initial energy. Energy
 // conservation without damping, and stability at 0.9 of the reported critical step.

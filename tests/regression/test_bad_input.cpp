@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bad input gets a clear one-line error naming the file, line and key, a non-zero exit and
 // no crash. Each case edits one line of a valid case file (or the command line).
 #include <gtest/gtest.h>

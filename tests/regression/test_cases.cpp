@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The cases of cases/ run through the `arlequin` executable, checked against their references.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The DCB in mode I (cases/dcb, docs/validation.md#r5) against the LEFM closed forms computed
 // here, P = (b^3 G^3 E I / 9)^1/4 Delta^-1/2 in propagation and the initiation load
 // sqrt(G b E I) / a0, against an independent cohesive-beam computation (below) for the peak,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Material regions: DEs take their region's material (density, group) and bonds get the set of
 // their materials, or the interface set across materials.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Virtual material tests, the calibration of beam bonds and the composite REV
 // (app/virtual_tests.hpp, app/calibrate.hpp, cases/rev_elastic; docs/validation.md R2, R3).
 #include <gtest/gtest.h>

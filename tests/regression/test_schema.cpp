@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The case-file schema (app/case_schema.cpp) against its readers: every key a reader asks for is
 // declared with the type, unit, range, choices and default it is read with (CaseNode checks
 // each read; a mismatch is a logic error, so any case or test that reads the key finds it),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Small DEM set-ups shared by the unit and verification tests.
 #pragma once
 #include <memory>

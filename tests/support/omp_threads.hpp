@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // For tests of thread independence: sets the OpenMP thread count for the scope's lifetime and
 // puts the previous count back, also when an assertion leaves the test early.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A fixture giving every test a fresh, empty folder of its own (dir_), removed afterwards.
 #pragma once
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Arlequin weighting of the DEM side: masses by max(alpha, floor) at the DE, bond stiffness
 // by alpha at the bond midpoint (docs/theory.md#weighted-models).
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // R1 (docs/validation.md): single beam bond responses against the closed forms of a linear
 // Euler-Bernoulli beam element, to 1e-9 relative. Small displacements (1e-5 of L) keep the
 // geometric non-linearity (O(d^2/L^2)) and the round-off well below that.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Prescribed motions of boundary conditions (dem/boundary.hpp) against their closed forms.
 #include <gtest/gtest.h>
 

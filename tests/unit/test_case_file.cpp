@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Case-file reading: typed values, defaults, resolved output, overrides and the one-line
 // error messages (location, key path, what was expected).
 #include "common/case_file.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The bilinear cohesive contact on two DEs against its closed forms (docs/theory.md#cohesive-contact):
 // the bilinear traction-opening curve in mode I and mode II, the quadratic onset and the
 // Benzeggagh-Kenane toughness along a fixed mixed path, the energy dissipated per unit area at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bond failure against closed forms: BBF thresholds in pure tension and pure bending, springs at
 // their maximum elongation, no force after a break, the RDEF virial stress of a uniformly
 // strained lattice, RDEF breaking every bond of a DE, and contact between former partners.

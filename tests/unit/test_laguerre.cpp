@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Laguerre cells (dem/laguerre_cells.hpp), the RDEF volume shares, against closed forms.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Closed-form UD composite moduli against the theory row of docs/validation.md R3 (seed Table 3).
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Output writers: atomic files, CSV series, JSON summaries and HDF5/XDMF fields.
 #include <gtest/gtest.h>
 

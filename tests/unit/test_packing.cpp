@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Dense random packings (seed "first challenge", docs/theory.md#packing) and sample files.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The rotation update of the drift (common/quat.hpp): the small-angle series of the rotation
 // quaternion against the sine and cosine in long double, and the division-free
 // renormalisation against the norm it must keep.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Verification of the explicit step against closed forms: free flight and spin, a bonded
 // pair's axial frequency, energy drift and momentum conservation of a bonded block, the
 // long-wave speed of a bonded chain, and an elastic head-on contact.

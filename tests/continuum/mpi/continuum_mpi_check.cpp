@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // continuum_mpi_check: the distributed static solve against a serial one, for CTest's
 // ContinuumMpi.MatchesSerial (run under `mpiexec -n 2`; any number of ranks works, one too).
 //
