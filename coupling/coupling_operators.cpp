@@ -4,9 +4,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "common/convex_polyhedron.hpp"
 #include "common/error.hpp"
+#include "dem/laguerre_cells.hpp"
 
 namespace arlequin::coupling {
 
@@ -136,14 +137,21 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
                                            const CouplingSettings& settings) {
   CouplingOperators op;
   op.settings = settings;
-  std::vector<Vec3> x;
+  std::vector<std::uint32_t> inside;
   for (std::size_t i = 0; i < p.size(); ++i)
-    if (zone.contains(p.reference[i])) {
-      op.particles.push_back(static_cast<std::uint32_t>(i));
-      x.push_back(p.reference[i]);
-      op.weight.push_back(4.0 / 3.0 * std::numbers::pi * p.radius[i] * p.radius[i] * p.radius[i]);
+    if (zone.contains(p.reference[i])) inside.push_back(static_cast<std::uint32_t>(i));
+  if (inside.empty()) throw SettingError("overlap", "no DE lies in the overlap (" + zone.description() + ")");
+  // W_p: the part of DE p's Laguerre cell (of the whole packing) inside the overlap. A DE whose
+  // centre lies on the overlap's boundary brings the part of its cell on the overlap's side only.
+  const std::vector<double> share = dem::laguerre_cell_measures(
+      p.reference, p.radius, inside, [&zone](const Polyhedron& cell) { return zone.volume_inside(cell); });
+  std::vector<Vec3> x;
+  for (std::size_t k = 0; k < inside.size(); ++k)
+    if (share[k] > 0.0) {  // a centre on the boundary within its tolerance, with no cell inside, has nothing to carry
+      op.particles.push_back(inside[k]);
+      x.push_back(p.reference[inside[k]]);
+      op.weight.push_back(share[k]);
     }
-  if (op.particles.empty()) throw SettingError("overlap", "no DE lies in the overlap (" + zone.description() + ")");
   if (settings.type == CouplingType::h1 && !(settings.length > 0.0))
     throw SettingError("length", "H1 coupling needs a positive length scale");
   if (settings.gradient_radius < 0.0) throw SettingError("overlap", "the gradient radius must not be negative");

@@ -9,8 +9,11 @@
 //  - N = continuum.interpolation(X_p): u_c(X_p) = sum_I N(p, I) u_I. Everything else is built
 //    from N, so any ContinuumSolver (fe, nem) works unchanged.
 //  - Quadrature of the overlap by the DEs (Xiao & Belytschko, CMAME 193 (2004) section 3):
-//    int_overlap f dV ~ sum_p W_p f(x_p), W_p = 4/3 pi R_p^3 (only ratios of W matter for the
-//    constrained motion).
+//    int_overlap f dV ~ sum_p W_p f(x_p), W_p = the volume of the part of DE p's Laguerre cell
+//    that lies in the overlap (OverlapZone::volume_inside; docs/theory.md#overlap-quadrature).
+//    The cells tile space, so the W_p tile the overlap, and a DE on the overlap's boundary
+//    brings only its cell's part inside (half of it on a lattice plane): counted whole, it
+//    left the coarse mediator a ghost force at h = 2a (docs/decisions.md#d29).
 //  - Coupling inner product on the particle cloud (Guidault & Belytschko, IJNME 70 (2007)):
 //      L2:  (l, w) = sum_p W_p l(x_p).w(x_p)                      S = W
 //      H1:  (l, w) += length^2 sum_p W_p grad l(x_p) : grad w(x_p)  S = W + length^2 sum_k D_k^T W D_k
@@ -60,7 +63,7 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 struct CouplingOperators {
   CouplingSettings settings;
   std::vector<std::uint32_t> particles;  // coupled DEs = columns of Gd
-  std::vector<double> weight;            // W_p, m^3
+  std::vector<double> weight;            // W_p, m^3 (> 0)
   std::vector<int> mediator_nodes;       // coarse: continuum node of each row; fine: empty
   SparseMatrix N;                        // particles x continuum nodes
   SparseMatrix Gd;                       // rows x particles

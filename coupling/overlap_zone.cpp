@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "common/error.hpp"
@@ -44,14 +45,42 @@ const char* weight_shape_name(WeightShape shape) {
   return "?";
 }
 
-OverlapZone::OverlapZone(Membership contains, RampCoordinate ramp, Weighting weighting, std::string description)
-    : contains_(std::move(contains)), ramp_(std::move(ramp)), weighting_(weighting), description_(std::move(description)) {
+OverlapZone::OverlapZone(Membership contains, RampCoordinate ramp, Polyhedral shape, Weighting weighting,
+                         std::string description)
+    : contains_(std::move(contains)),
+      ramp_(std::move(ramp)),
+      shape_(std::move(shape)),
+      weighting_(weighting),
+      description_(std::move(description)) {
   check_weighting(weighting_);
 }
 
-OverlapZone::OverlapZone(const Region& region, RampCoordinate ramp, Weighting weighting)
-    : OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting,
-                  region.describe()) {}
+std::vector<OverlapZone::Plane> OverlapZone::box_planes(const Box& b) {
+  std::vector<Plane> planes;
+  for (int k = 0; k < 3; ++k) {
+    Vec3 n{};
+    n[k] = 1.0;
+    planes.push_back({n, b.upper[k]});
+    planes.push_back({-1.0 * n, -b.lower[k]});
+  }
+  return planes;
+}
+
+double OverlapZone::volume_inside(const Polyhedron& cell) const {
+  double extent = 0.0;
+  Vec3 first = cell.empty() || cell.front().pts.empty() ? Vec3{} : cell.front().pts.front();
+  for (const PolyFace& f : cell)
+    for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - first));
+  const double tol = 1e-12 * extent;
+  auto clipped = [&](Polyhedron poly, const std::vector<Plane>& planes) {
+    for (const Plane& plane : planes) clip(poly, plane.n, plane.d, -2, tol);
+    return poly;
+  };
+  const Polyhedron solid = clipped(cell, shape_.solid);
+  double v = volume(solid);
+  if (!shape_.hole.empty()) v -= volume(clipped(solid, shape_.hole));
+  return std::max(v, 0.0);
+}
 
 bool OverlapZone::in_dem_domain(const Vec3& x) const { return ramp_(x) <= 1.0 + kRampTolerance; }
 bool OverlapZone::in_pure_dem_zone(const Vec3& x) const { return ramp_(x) <= kRampTolerance; }
@@ -82,7 +111,8 @@ OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Wei
   std::ostringstream d;
   d << "box " << vec(b.lower) << "-" << vec(b.upper) << ", ramp along axis " << axis << " with the DEM on the "
     << (dem_on_lower_side ? "lower" : "upper") << " side";
-  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting, d.str());
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), {box_planes(b), {}},
+                     weighting, d.str());
 }
 
 OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting weighting) {
@@ -93,11 +123,24 @@ OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting
     const double s = dot(x - base, axis) / length;
     return dem_at_base ? s : 1.0 - s;
   };
+  // The end planes, and the curved side as the circumscribed regular polygon: its faces touch
+  // the circle at their middles, at distance `radius` from the axis.
+  Polyhedral shape;
+  shape.solid.push_back({axis, dot(axis, base) + length});
+  shape.solid.push_back({-1.0 * axis, -dot(axis, base)});
+  const Vec3 e1 = normalized(std::abs(axis.x) < 0.9 ? cross(axis, Vec3{1, 0, 0}) : cross(axis, Vec3{0, 1, 0}));
+  const Vec3 e2 = cross(axis, e1);
+  for (int k = 0; k < kCylinderSides; ++k) {
+    const double phi = 2.0 * std::numbers::pi * k / kCylinderSides;
+    const Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
+    shape.solid.push_back({n, dot(n, base) + c.radius});
+  }
   const Region region{c};
   std::ostringstream d;
   d << "cylinder base " << vec(base) << " axis " << vec(axis) << " radius " << c.radius << " length " << length
     << ", ramp along the axis with the DEM at the " << (dem_at_base ? "base" : "top");
-  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), weighting, d.str());
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), std::move(shape),
+                     weighting, d.str());
 }
 
 OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting weighting) {
@@ -123,7 +166,7 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
   std::ostringstream d;
   d << "shell between box " << vec(inner.lower) << "-" << vec(inner.upper) << " (DEM inside) and box "
     << vec(outer.lower) << "-" << vec(outer.upper);
-  return OverlapZone(std::move(contains), std::move(ramp), weighting, d.str());
+  return OverlapZone(std::move(contains), std::move(ramp), {box_planes(outer), box_planes(inner)}, weighting, d.str());
 }
 
 }  // namespace arlequin::coupling

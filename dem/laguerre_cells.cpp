@@ -75,12 +75,18 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
 
 }  // namespace
 
+std::vector<double> laguerre_cell_measures(const std::vector<Vec3>& c, const std::vector<double>& r,
+                                           const std::vector<std::uint32_t>& cells,
+                                           const std::function<double(const Polyhedron&)>& measure) {
+  std::vector<double> values(cells.size(), 0.0);
+  for_each_cell(c, r, cells, [&](std::size_t k, const Polyhedron& poly) { values[k] = measure(poly); });
+  return values;
+}
+
 std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vector<double>& r) {
   std::vector<std::uint32_t> all(c.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
-  std::vector<double> volumes(c.size(), 0.0);
-  for_each_cell(c, r, all, [&](std::size_t k, const Polyhedron& poly) { volumes[k] = volume(poly); });
-  return volumes;
+  return laguerre_cell_measures(c, r, all, [](const Polyhedron& poly) { return volume(poly); });
 }
 
 std::vector<std::vector<LaguerreFace>> laguerre_faces(const std::vector<Vec3>& c, const std::vector<double>& r,

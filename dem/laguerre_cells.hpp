@@ -9,14 +9,23 @@
 // discrete divergence (the Arlequin overlap's consistent quadrature, coupling/coupled_model.hpp).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
+#include "common/convex_polyhedron.hpp"
 #include "common/vec3.hpp"
 
 namespace arlequin::dem {
 
 // Volume of every sphere's Laguerre cell within the box [min(c - R), max(c + R)] (m^3).
 std::vector<double> laguerre_volumes(const std::vector<Vec3>& centres, const std::vector<double>& radii);
+
+// measure(cell) for the Laguerre cell of each sphere in `cells` (indices into centres), in that
+// order; all spheres take part in the tessellation. E.g. the part of a cell inside a region
+// (the Arlequin overlap's share of a coupled DE, coupling/coupling_operators.hpp).
+std::vector<double> laguerre_cell_measures(const std::vector<Vec3>& centres, const std::vector<double>& radii,
+                                           const std::vector<std::uint32_t>& cells,
+                                           const std::function<double(const Polyhedron&)>& measure);
 
 // A face between a cell and a neighbour's: area vector (area times the unit normal pointing out
 // of the cell, m^2) and area centroid (m). Faces on the box are not listed.

@@ -2,6 +2,9 @@
 // Overlap zone and weight functions: alpha_d + alpha_c = 1, shapes across the ramp, membership.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "common/error.hpp"
 #include "coupling/overlap_zone.hpp"
 
@@ -62,6 +65,33 @@ TEST(CouplingOverlapZone, ShellAndCylinder) {
   EXPECT_DOUBLE_EQ(cyl.alpha_d({0, 0, 1}), 0.75);
   EXPECT_TRUE(cyl.contains({0.5, 0, 1}));
   EXPECT_FALSE(cyl.contains({1.5, 0, 1}));
+}
+
+// A coupled DE's share of the overlap (coupling_operators.hpp): the part of its cell inside,
+// against the volumes of the clipped boxes worked out by hand.
+TEST(CouplingOverlapZone, CellVolumeInsideTheOverlap) {
+  auto cube = [](const Vec3& centre, double side) {
+    return box_polyhedron(centre - Vec3{side / 2, side / 2, side / 2}, centre + Vec3{side / 2, side / 2, side / 2}, 0);
+  };
+  const OverlapZone slab = OverlapZone::box({{0, -5, -5}, {1, 5, 5}}, 0, true, {});
+  EXPECT_NEAR(slab.volume_inside(cube({0.5, 0, 0}, 0.5)), 0.125, 1e-15);     // inside: whole
+  EXPECT_NEAR(slab.volume_inside(cube({0, 0, 0}, 0.5)), 0.0625, 1e-15);      // on the DEM-side face: half
+  EXPECT_NEAR(slab.volume_inside(cube({1, 0.3, 0}, 0.5)), 0.0625, 1e-15);    // on the continuum-side face: half
+  EXPECT_NEAR(slab.volume_inside(cube({0.9, 0, 0}, 0.4)), 0.3 * 0.16, 1e-15);  // 0.3 of its 0.4 length inside
+  EXPECT_EQ(slab.volume_inside(cube({2, 0, 0}, 0.5)), 0.0);                 // outside
+  // Shell: a unit cube with a corner in the inner box keeps 1 - 1/8.
+  const OverlapZone shell = OverlapZone::shell({{-1, -1, -1}, {1, 1, 1}}, {{-3, -3, -3}, {3, 3, 3}}, {});
+  EXPECT_NEAR(shell.volume_inside(cube({1, 1, 1}, 1.0)), 0.875, 1e-14);
+  EXPECT_NEAR(shell.volume_inside(cube({3, 0, 0}, 1.0)), 0.5, 1e-14);
+  EXPECT_EQ(shell.volume_inside(cube({0, 0, 0}, 1.0)), 0.0);
+  // Cylinder of radius 1 along z from 0 to 2: a box around it cut at z = 1 keeps the
+  // circumscribed polygon's prism of height 1, n tan(pi / n) r^2, within 2.1e-4 of pi.
+  const OverlapZone cyl = OverlapZone::cylinder({{0, 0, 0}, {0, 0, 1}, 1.0, 2.0}, true, {});
+  const double n = OverlapZone::kCylinderSides;
+  const double prism = cyl.volume_inside(box_polyhedron({-2, -2, -1}, {2, 2, 1}, 0));
+  EXPECT_NEAR(prism, n * std::tan(std::numbers::pi / n), 1e-12);
+  EXPECT_NEAR(prism / std::numbers::pi - 1.0, 2.0e-4, 0.1e-4);
+  EXPECT_NEAR(cyl.volume_inside(cube({0, 0, 1}, 0.5)), 0.125, 1e-15);  // well inside the side
 }
 
 TEST(CouplingOverlapZone, BadInputIsAnInputError) {
