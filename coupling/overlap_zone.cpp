@@ -68,12 +68,12 @@ std::vector<OverlapZone::Plane> OverlapZone::box_planes(const Box& b) {
 
 double OverlapZone::volume_inside(const Polyhedron& cell) const {
   double extent = 0.0;
-  Vec3 first = cell.empty() || cell.front().pts.empty() ? Vec3{} : cell.front().pts.front();
+  const Vec3 first = cell.empty() || cell.front().pts.empty() ? Vec3{} : cell.front().pts.front();
   for (const PolyFace& f : cell)
     for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - first));
   const double tol = 1e-12 * extent;
   auto clipped = [&](Polyhedron poly, const std::vector<Plane>& planes) {
-    for (const Plane& plane : planes) clip(poly, plane.n, plane.d, -2, tol);
+    for (const Plane& plane : planes) clip(poly, plane.n, plane.d, /*tag, not read here*/ -1, tol);
     return poly;
   };
   const Polyhedron solid = clipped(cell, shape_.solid);
