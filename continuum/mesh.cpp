@@ -115,6 +115,8 @@ Mesh Mesh::load(const MeshSource& source) {
     }
   } catch (const std::exception& e) {
     throw InputError("gmsh could not mesh/read " + source.path + ": " + e.what());
+  } catch (const std::string& message) {  // gmsh 4.8 throws its error message as a std::string
+    throw InputError("gmsh could not mesh/read " + source.path + ": " + message);
   }
 
   std::vector<std::size_t> node_tags;

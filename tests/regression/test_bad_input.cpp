@@ -158,5 +158,28 @@ TEST(BadInput, UnknownCommandSuggestsTheClosest) {
   EXPECT_NE(r.output.find("did you mean 'run'"), std::string::npos) << r.output;
 }
 
+// A mesh gmsh cannot read (a syntax error in a .geo, a truncated .msh) is an input error naming
+// the file (and the .geo's line), not an uncaught exception (it was: exit 134, no file named).
+TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto dir = test::scratch_dir("bad_mesh");
+  std::ofstream(dir / "syntax.geo") << "Point(1) = {0, 0, 0;\n";
+  std::ofstream(dir / "truncated.msh") << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 8 1 8\n3 1 0 8\n1\n2\n";
+  const std::string bar = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/bar_wave_continuum/case.yaml";
+  for (const std::string file : {"syntax.geo", "truncated.msh"}) {
+    const std::string path = (dir / file).string();
+    const auto r = test::run_arlequin("check " + bar + " --set continuum.mesh.file=" + path);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_EQ(r.output.rfind("arlequin: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find("continuum.mesh.file"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(path), std::string::npos) << r.output;
+  }
+  const auto r = test::run_arlequin("check " + bar + " --set continuum.mesh.file=" + (dir / "syntax.geo").string());
+  EXPECT_NE(r.output.find("line 1"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace arlequin
