@@ -130,7 +130,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
     if (*user_dt > scene.dt_critical) {
       std::ostringstream msg;
       msg << "time step " << *user_dt << " s is above the critical time step " << scene.dt_critical
-          << " s (2/omega_max over bonds, contacts and the continuum); use dt <= " << scene.dt_critical << " or dt: auto";
+          << " s (2/omega_max over bonds, contacts and the continuum, lowered by damping; docs/theory.md#critical-step); use dt <= " << scene.dt_critical << " or dt: auto";
       time->fail("dt", msg.str());
     }
     scene.dt = *user_dt;

@@ -127,7 +127,15 @@ double DemModel::critical_time_step() const {
   }
   double omega2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) omega2 = std::max({omega2, trans[i], rot[i]});
-  return omega2 > 0.0 ? 2.0 / std::sqrt(omega2) : std::numeric_limits<double>::infinity();
+  // Viscous damping c is applied from the half-step velocity (apply_loads_and_damping), so a
+  // mode of frequency omega steps as v' = (1 - c dt) v - dt omega^2 x, x' = x + dt v'; its
+  // amplification matrix has det 1 - c dt and trace 2 - c dt - dt^2 omega^2, and both roots stay
+  // inside the unit circle iff dt^2 omega^2 + 2 c dt < 4 (Jury's conditions; derived here,
+  // docs/theory.md#critical-step): dt_c = 4 / (c + sqrt(c^2 + 4 omega^2)), which is 2/omega
+  // undamped (to the bit) and 2/c for a DE without bonds.
+  const double c = damping_;
+  if (!(omega2 > 0.0) && !(c > 0.0)) return std::numeric_limits<double>::infinity();
+  return 4.0 / (c + std::sqrt(c * c + 4.0 * omega2));
 }
 
 void DemModel::step(double dt) {
@@ -450,7 +458,9 @@ void DemModel::check_energy(double energy_limit) const {
       << " J exceeds the blow-up limit " << energy_limit << " J (fastest DE: " << fastest << " at ("
       << p.position[fastest].x << ", " << p.position[fastest].y << ", " << p.position[fastest].z
       << ") m); likely cause: a time step too close to the stability limit for the stiffest bond or "
-         "contact, or energy injected by boundary conditions";
+         "contact";
+  if (damping_ > 0.0) msg << " or for the viscous damping (c dt = " << damping_ * last_dt_ << ", stable below 2)";
+  msg << ", or energy injected by boundary conditions";
   throw RunError(msg.str());
 }
 

@@ -376,6 +376,21 @@ TEST(Cases, APlotThatCannotBeDrawnIsSkippedInOneLine) {
 
 // BBF in a structure: a simple-cubic lattice bar fails at 36 S sigma_f (the case's own check),
 // its breaks are recorded, and the fracture energy closes the energy balance.
+// Heavy damping (c dt up to 3.3 at the undamped step's 0.1) blew up with a message that blamed
+// the bonds: the critical step now includes the damping (dt^2 omega^2 + 2 c dt < 4), so the run
+// completes, and a step above the damped limit is refused saying so.
+TEST(Cases, HeavyDampingLowersTheCriticalStep) {
+  const auto out = test::scratch_dir("lattice_bar_damped");
+  const std::string run = "run " + cases + "lattice_bar_failure/case.yaml --quiet --set output.fields=[] --set dem.damping=1e8 ";
+  test::run_arlequin(run + "--set time.end=3e-5 --out " + out.string());
+  const Json s = read_json_file(out / "summary.json");
+  EXPECT_EQ(s.at("status").get<std::string>(), "completed") << s.dump();
+  EXPECT_LT(s.at("dt_critical").get<double>(), 2.0 / 1e8);
+  const auto refused = test::run_arlequin(run + "--set time.dt=3e-8 --out " + out.string());
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("lowered by damping"), std::string::npos) << refused.output;
+}
+
 TEST(Cases, LatticeBarFailsAtTheBondStrength) {
   const auto out = test::scratch_dir("lattice_bar_failure");
   const auto r = test::run_arlequin("run " + cases + "lattice_bar_failure/case.yaml --quiet --out " + out.string());
@@ -448,7 +463,7 @@ TEST(Cases, WaveBarCoupledRefusesAStepAboveTheCriticalOne) {
   const auto r = test::run_arlequin("run " + cases + "wave_bar_coupled/case.yaml --quiet --out " + out.string() + " --set time.dt=1e-6");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("time.dt: time step 1e-06 s is above the critical time step"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("and the continuum); use dt <= "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("and the continuum, lowered by damping; docs/theory.md#critical-step); use dt <= "), std::string::npos) << r.output;
 }
 
 // R6 on a 3D bar: the pulse leaves the DEM through the overlap; the energy left behind is R.

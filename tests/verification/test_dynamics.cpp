@@ -217,5 +217,39 @@ TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
   EXPECT_GT(model.critical_time_step(), 0.25 * 2.0 / omega_axial);
 }
 
+// Viscous damping applied from the half-step velocity multiplies a free DE's half-step velocity
+// by (1 - c dt) per step: stable for c dt < 2 only, so the critical step of DEs without bonds is
+// 2/c. A step 2 % above it makes the motion grow (1.04^400 = 6.5e6, less the two factors
+// 1 - c dt/2 = -0.02 between full and half steps), 2 % below it decays (0.96^400 = 8e-8).
+TEST(Damping, CriticalStepOfFreeDesIsTwoOverC) {
+  const double c = 1e8;  // 1/s
+  for (const double factor : {0.98, 1.02}) {
+    DemModel model;
+    model.particles.add({0, 0, 0}, 1e-3, steel);
+    model.particles.velocity[0] = {1.0, 0, 0};
+    model.set_damping(c);
+    model.finalize();
+    EXPECT_DOUBLE_EQ(model.critical_time_step(), 2.0 / c);
+    for (int n = 0; n < 400; ++n) model.step(factor * model.critical_time_step());
+    const double speed = norm(model.particles.velocity[0]);
+    if (factor < 1.0) EXPECT_LT(speed, 1e-6);
+    else EXPECT_GT(speed, 1e3);
+  }
+}
+
+// With bonds the limit is dt^2 omega^2 + 2 c dt < 4 (docs/theory.md#critical-step): the damped
+// step follows from the undamped one's omega, and is that step to the bit without damping.
+TEST_F(BondedPair, DampingLowersTheCriticalStepByTheClosedForm) {
+  model.finalize();
+  const double undamped = model.critical_time_step();
+  const double omega = 2.0 / undamped, c = 0.5 * omega;
+  model.set_damping(c);
+  const double damped = model.critical_time_step();
+  EXPECT_DOUBLE_EQ(damped, 4.0 / (c + std::sqrt(c * c + 4.0 * omega * omega)));
+  EXPECT_NEAR(damped * damped * omega * omega + 2.0 * c * damped, 4.0, 1e-12);
+  model.set_damping(0.0);
+  EXPECT_EQ(model.critical_time_step(), undamped);
+}
+
 }  // namespace
 }  // namespace arlequin::dem
