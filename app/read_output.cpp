@@ -94,7 +94,9 @@ void read_sensors(CaseNode root, Scene& scene) {
   static constexpr std::string_view crack_quantities[] = {"tip", "damage_front", "crack_growth", "softening_zone", "process_zone",
                                                           "dissipated"};
   const bool has_dem = scene.dem.particles.size() > 0;
+  std::vector<CaseNode> nodes;
   for (CaseNode s : root.list_or_empty("sensors")) {
+    nodes.push_back(s);
     Sensor sensor;
     sensor.name = s.string("name");
     if (sensor.name.empty() || sensor.name.find_first_of(", \"") != std::string::npos)
@@ -165,6 +167,22 @@ void read_sensors(CaseNode root, Scene& scene) {
     }
     s.finish();
     scene.sensors.push_back(sensor);
+  }
+  // A sensor's columns may repeat no column of series.csv, built-in or another sensor's: a
+  // check or a plot would read the first of two columns of one name.
+  std::vector<std::string> taken{"time", "step", "C_kinetic", "C_strain"};
+  taken.insert(taken.end(), std::begin(energy_columns), std::end(energy_columns));
+  taken.insert(taken.end(), std::begin(coupling_columns), std::end(coupling_columns));
+  for (std::size_t k = 0; k < scene.sensors.size(); ++k) {
+    const Sensor& s = scene.sensors[k];
+    std::vector<std::string> columns{s.name};
+    if (s.component < 0) columns = {s.name + "_x", s.name + "_y", s.name + "_z"};
+    for (const std::string& c : columns) {
+      if (std::find(taken.begin(), taken.end(), c) != taken.end() || c.rfind("broken_", 0) == 0)
+        nodes[k].fail("name", "series.csv already has a column '" + c +
+                                  "' (built-in: time, step, the energies, the coupling's and broken_<bond set>; or another sensor's)");
+      taken.push_back(c);
+    }
   }
 }
 

@@ -140,6 +140,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"cohesive_precrack_longer_than_specimen", 6,
                  cohesive_interface("sigma_max: 5.7e6, G_I: 560, stiffness: 1.0e15, precrack: {box: [[-1, -1, -1], [1, 1, 1]]}"), "",
                  {"case.yaml:", "dem.interface.bond.precrack", "as long as the specimen"}, 4, no_density},
+        // A sensor column named like a built-in one or another sensor's: series.csv got two
+        // columns of one name and a check judged the first.
+        BadInput{"sensor_named_like_a_builtin_column", 14, "  - {name: E_total, type: force, group: right, component: x}", "",
+                 {"case.yaml:14", "sensors[0].name", "column 'E_total'"}},
+        BadInput{"sensor_named_time", 14, "  - {name: time, type: force, group: right, component: x}", "",
+                 {"case.yaml:14", "sensors[0].name", "column 'time'"}},
+        BadInput{"sensor_column_of_another_sensor", 14,
+                 "  - {name: F, type: force, group: right}\n  - {name: F_y, type: force, group: right, component: y}", "",
+                 {"case.yaml:15", "sensors[1].name", "column 'F_y'"}},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),
