@@ -81,6 +81,19 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   Scene scene;
   scene.case_file = case_file;
   scene.name = root.string_or("name", case_file.parent_path().filename().string());
+  // The name is the default output folder's last component (results/<name>) and the packing
+  // cache's: one plain component of portable characters, so that it cannot reach outside
+  // results/ ("..", "/") or write a name other tools cannot read back (a NUL, bad UTF-8).
+  const bool portable = !scene.name.empty() && scene.name.front() != '.' &&
+                        std::all_of(scene.name.begin(), scene.name.end(), [](char c) {
+                          return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                                 c == '_' || c == '-' || c == '.' || c == '+';
+                        });
+  if (!portable) {
+    const std::string expected = "a name of letters, digits, '_', '-', '+' and '.' (not first): it names the output folder results/<name>";
+    if (root.has("name")) root.fail("name", expected);
+    throw InputError(case_file.string() + ": name: the case folder's name is not " + expected + "; give the case a name:");
+  }
   static constexpr std::string_view unit_systems[] = {"SI"};
   root.choice_or("units", "SI", unit_systems);
   scene.output.dir = prepare_output_dir(root.child_if("output"), scene.name, options);

@@ -17,9 +17,11 @@ namespace arlequin {
 
 using Json = nlohmann::ordered_json;
 
-// The document, indented by two spaces, through a temporary file and a rename.
+// The document, indented by two spaces, through a temporary file and a rename. A string that is
+// not valid UTF-8 (a name or a path from the user's file system) is written with U+FFFD for
+// each bad byte, so the file is always JSON.
 inline void write_json_atomically(const std::filesystem::path& path, const Json& json) {
-  write_file_atomically(path, json.dump(2) + '\n');
+  write_file_atomically(path, json.dump(2, ' ', false, Json::error_handler_t::replace) + '\n');
 }
 
 // The whole file as one document; InputError naming the file when it cannot be read or is not

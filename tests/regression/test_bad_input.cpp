@@ -149,6 +149,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"sensor_column_of_another_sensor", 14,
                  "  - {name: F, type: force, group: right}\n  - {name: F_y, type: force, group: right, component: y}", "",
                  {"case.yaml:15", "sensors[1].name", "column 'F_y'"}},
+        // The name is the output folder's last component: no way out of results/, no NUL.
+        BadInput{"name_leaving_results", 1, "name: ../../..", "", {"case.yaml:1", "name", "results/<name>"}},
+        BadInput{"name_with_a_nul", 1, "name: \"a\\0b\"", "", {"case.yaml:1", "name", "results/<name>"}},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),

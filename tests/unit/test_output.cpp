@@ -71,6 +71,16 @@ TEST_F(OutputTest, CsvSeriesRoundTrip) {
 // Our contract over nlohmann-json: summaries keep their keys in insertion order, non-finite
 // numbers become null, the file is replaced atomically, and a file that is not JSON is an
 // InputError naming it.
+// A string that is not UTF-8 (a byte 0xff from a folder or a sensor name) still gives a JSON
+// file: the bad byte becomes U+FFFD (it made summary.json invalid, or the dump threw).
+TEST_F(OutputTest, JsonFileIsValidWithAStringThatIsNotUtf8) {
+  Json summary = Json::object();
+  summary["name"] = std::string("case\xff" "1");
+  const fs::path path = dir_ / "summary.json";
+  write_json_atomically(path, summary);
+  EXPECT_EQ(read_json_file(path).at("name").get<std::string>(), "case\xef\xbf\xbd" "1");
+}
+
 TEST_F(OutputTest, JsonFilesKeepOrderWriteNullForNonFiniteAndNameABadFile) {
   Json summary = Json::object();
   summary["steps"] = std::size_t{1000};
