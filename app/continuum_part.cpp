@@ -184,9 +184,23 @@ ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_
   static constexpr std::string_view shapes[] = {"sibson", "laplace"};
   out.solver.shape_functions = section.choice_or("shape_functions", "sibson", shapes);
   out.solver.nem_stabilization = section.number_or("stabilization", 1.0, Range::positive(), "1");
-  out.solver.petsc_options = section.string_or("petsc_options", "") + " " + extra_petsc_options;
+  const std::string own_options = section.string_or("petsc_options", "");
+  out.solver.petsc_options = own_options + " " + extra_petsc_options;
   static constexpr std::string_view analyses[] = {"explicit", "static"};
   out.is_static = section.choice_or("analysis", "explicit", analyses) == "static";
+  // Options that nothing reads are an error, not silence: the explicit step solves nothing.
+  const bool any_options = out.solver.petsc_options.find_first_not_of(' ') != std::string::npos;
+  if (any_options && !out.is_static) {
+    if (!own_options.empty()) section.fail("petsc_options", "is read by analysis: static only (an explicit run solves no system)");
+    throw InputError("--petsc: PETSc options are read by a static continuum solve only; this case's continuum is explicit");
+  }
+  if (any_options) try {
+      continuum::ContinuumSolver::check_static_solver_options(out.solver.petsc_options);
+    } catch (const SettingError& e) {
+      const bool both = extra_petsc_options.find_first_not_of(' ') != std::string::npos;
+      if (!own_options.empty()) section.fail("petsc_options", both ? e.message() + " (with --petsc)" : e.message());
+      throw InputError("--petsc: " + e.message());
+    }
   for (CaseNode bc : section.list_or_empty("boundary")) out.boundaries.push_back(read_continuum_boundary(bc));
   section.finish();
   return out;

@@ -55,7 +55,7 @@ constexpr const char* usage_run =
     "  --out DIR      write results to DIR instead of output.dir of the case\n"
     "  --set k=v      override a case value (YAML syntax), e.g. --set time.end=1e-3\n"
     "  --steps N      stop after N steps (before time.end the case's checks are not evaluated)\n"
-    "  --petsc \"...\"  PETSc options for continuum solves, e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
+    "  --petsc \"...\"  PETSc options of a static continuum solve (checked before the run), e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
     "  --quiet        no progress line\n"
     "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed,\n"
     "  130 / 143 interrupted by Ctrl-C / SIGTERM (outputs so far closed and kept)\n";

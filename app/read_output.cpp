@@ -173,12 +173,13 @@ void read_sensors(CaseNode root, Scene& scene) {
   std::vector<std::string> taken{"time", "step", "C_kinetic", "C_strain"};
   taken.insert(taken.end(), std::begin(energy_columns), std::end(energy_columns));
   taken.insert(taken.end(), std::begin(coupling_columns), std::end(coupling_columns));
+  for (const auto& set : scene.dem.bond_sets()) taken.push_back("broken_" + set->name);
   for (std::size_t k = 0; k < scene.sensors.size(); ++k) {
     const Sensor& s = scene.sensors[k];
     std::vector<std::string> columns{s.name};
     if (s.component < 0) columns = {s.name + "_x", s.name + "_y", s.name + "_z"};
     for (const std::string& c : columns) {
-      if (std::find(taken.begin(), taken.end(), c) != taken.end() || c.rfind("broken_", 0) == 0)
+      if (std::find(taken.begin(), taken.end(), c) != taken.end())
         nodes[k].fail("name", "series.csv already has a column '" + c +
                                   "' (built-in: time, step, the energies, the coupling's and broken_<bond set>; or another sensor's)");
       taken.push_back(c);

@@ -25,7 +25,48 @@ constexpr double kTriW[2] = {0.223381589678011, 0.109951743655322};
 
 void check(PetscErrorCode code, const char* what) { petsc_check(static_cast<int>(code), what); }
 
+// The static solve's defaults (CG, algebraic multigrid, relative tolerance 1e-12), set before
+// the case's options so that those win and only theirs are checked; then KSPSetFromOptions
+// under PETSc's quiet error handler (a refused option is the case's error, said once in one
+// line, not PETSc's trace). SettingError at petsc_options when PETSc refuses an option or
+// leaves one unread. `scope` holds `options`.
+void set_static_solver_options(KSP ksp, const ScopedPetscOptions& scope, const std::string& options) {
+  PC pc;
+  check(KSPGetPC(ksp, &pc), "KSPGetPC");
+  check(KSPSetType(ksp, KSPCG), "KSPSetType");
+  check(PCSetType(pc, PCGAMG), "PCSetType");
+  check(KSPSetTolerances(ksp, 1e-12, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT), "KSPSetTolerances");
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  const PetscErrorCode read = KSPSetFromOptions(ksp);
+  PetscPopErrorHandler();
+  if (read != 0) throw SettingError("petsc_options", "PETSc refused '" + options + "' (an unknown KSP or PC type?)");
+  if (const std::string unused = scope.unused(); !unused.empty())
+    throw SettingError("petsc_options", "PETSc did not use '" + unused + "' (misspelt, or for a solver type not chosen)");
+}
+
 }  // namespace
+
+void ContinuumSolver::check_static_solver_options(const std::string& petsc_options) {
+  PetscSession::ensure(petsc_options);
+  Mat A;
+  check(MatCreateSeqAIJ(PETSC_COMM_SELF, 1, 1, 1, nullptr, &A), "MatCreateSeqAIJ");
+  check(MatSetValue(A, 0, 0, 1.0, INSERT_VALUES), "MatSetValue");
+  check(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  KSP ksp;
+  check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
+  check(KSPSetOperators(ksp, A, A), "KSPSetOperators");
+  try {
+    const ScopedPetscOptions scope(petsc_options);
+    set_static_solver_options(ksp, scope, petsc_options);
+  } catch (...) {
+    KSPDestroy(&ksp);
+    MatDestroy(&A);
+    throw;
+  }
+  KSPDestroy(&ksp);
+  MatDestroy(&A);
+}
 
 ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings) : mesh_(Mesh::load(settings.mesh)) {
   PetscSession::ensure(settings.petsc_options);
@@ -452,10 +493,10 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
   KSPConvergedReason reason;
   {
     // The option string in a database of its own while the solver is set up and run.
-    const ScopedPetscOptions options("-ksp_type cg -pc_type gamg -ksp_rtol 1e-12 " + petsc_options);
+    const ScopedPetscOptions options(petsc_options);
     check(KSPCreate(comm, &ksp), "KSPCreate");
     check(KSPSetOperators(ksp, K, K), "KSPSetOperators");
-    check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+    set_static_solver_options(ksp, options, petsc_options);
     check(KSPSolve(ksp, b, x), "KSPSolve");
     check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
   }

@@ -119,6 +119,9 @@ class ContinuumSolver {
 
   // Static equilibrium at the current time; leaves u solved, v untouched, forces updated.
   void solve_static(const std::string& petsc_options = "");
+  // SettingError at "petsc_options" when PETSc refuses the static solve's options or leaves one
+  // unread (checked on a 1 x 1 system, so a case is refused before its run; starts PETSc).
+  static void check_static_solver_options(const std::string& petsc_options);
 
   void internal_force(const Field& u, Field& f_int) const;
   // 1/2 u.K u: one pass over K. A rigid part of u cancels to round-off eps |K| |u|^2 (the point

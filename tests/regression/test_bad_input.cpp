@@ -193,5 +193,30 @@ TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
   EXPECT_NE(r.output.find("line 1"), std::string::npos) << r.output;
 }
 
+// The continuum's PETSc options are checked before the run, as the coupling's are: an option
+// PETSc refuses or leaves unread, or options given to a continuum that solves nothing (explicit),
+// is a one-line error (they were ignored, or failed the run with PETSc's trace).
+TEST(BadInput, ContinuumPetscOptionsAreChecked) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const std::string cases = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/";
+  const std::string static_case = "check " + cases + "cantilever_continuum/case.yaml --petsc ";
+  struct Refusal {
+    std::string command;
+    std::vector<std::string> expected;
+  };
+  for (const Refusal& r : std::vector<Refusal>{
+           {static_case + "\"-ksp_type bogus\"", {"continuum.petsc_options", "PETSc refused", "-ksp_type bogus"}},
+           {static_case + "\"-nonexistent_option 1\"", {"continuum.petsc_options", "did not use '-nonexistent_option 1'"}},
+           {"check " + cases + "bar_wave_continuum/case.yaml --petsc \"-ksp_type cg\"", {"--petsc", "static", "explicit"}}}) {
+    const auto out = test::run_arlequin(r.command);
+    EXPECT_EQ(out.exit_code, 2) << out.output;
+    EXPECT_EQ(std::count(out.output.begin(), out.output.end(), '\n'), 1) << out.output;
+    for (const auto& s : r.expected) EXPECT_NE(out.output.find(s), std::string::npos) << "missing '" << s << "' in: " << out.output;
+  }
+  EXPECT_EQ(test::run_arlequin(static_case + "\"-ksp_type gmres -ksp_monitor_cancel\"").exit_code, 0);
+}
+
 }  // namespace
 }  // namespace arlequin
