@@ -339,7 +339,10 @@ int calibrate(const Arguments& a) {
 
 int check(const Arguments& a) {
   app::SceneOptions options = a.scene;
-  options.check_output_dir = false;  // validating a case writes nothing, so may run where nothing can be written
+  // Validating a case writes nothing (no output folder, no packing cache), so it may run where
+  // nothing can be written.
+  options.check_output_dir = false;
+  options.write_sample_cache = false;
   app::Scene scene = app::build_scene(a.case_file, options);
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
   print_scene_facts(scene);

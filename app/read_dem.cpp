@@ -149,7 +149,7 @@ void read_packing(CaseNode sample, Scene& scene, double density, const SceneOpti
   } catch (const RunError& e) {
     sample.fail("compaction", e.what());
   }
-  dem::save_sample(file, p, spec, scene.sample->report);
+  if (options.write_sample_cache) dem::save_sample(file, p, spec, scene.sample->report);
 }
 
 void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {

@@ -118,6 +118,7 @@ struct SceneOptions {
   std::string petsc_options;           // --petsc "...", after the case's own
   bool rebuild_sample = false;         // build the packing even if its cache file matches
   bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
+  bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
 };
 
 // Column names of series.csv for the scene's sensors (one, or three for component: all).

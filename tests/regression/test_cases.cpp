@@ -189,6 +189,26 @@ TEST(Cases, ContinuumCasesPassTheirChecksWithBothSolvers) {
   }
 }
 
+// `check` writes nothing: a packing it has to build is not cached beside the case (it was, in
+// <case folder>/results/, though the README says check writes nothing); `run` caches it there.
+TEST(Cli, CheckWritesNothingNotEvenThePackingCache) {
+  const auto dir = test::scratch_dir("check_writes_nothing");
+  std::ofstream(dir / "case.yaml") << "name: small_packing\n"
+                                      "time: {end: 1.0e-6}\n"
+                                      "dem:\n"
+                                      "  density: 1600\n"
+                                      "  sample: {build: packing, region: {box: [[0, 0, 0], [0.003, 0.003, 0.003]]}, compaction: 0.55, min_coordination: 4, "
+                                      "radius: {mean: 2.5e-4}}\n"
+                                      "  bond: {law: beam, E_mu: 1.0e11, r_mu: 0.5}\n";
+  const auto r = test::run_arlequin("check " + (dir / "case.yaml").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "results")) << "check wrote into the case folder";
+  const auto out = test::scratch_dir("check_writes_nothing_out");
+  const auto run = test::run_arlequin("run " + (dir / "case.yaml").string() + " --quiet --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "results" / "small_packing" / "sample.h5"));
+}
+
 TEST(Cli, SweepTabulatesErrorAgainstRunTime) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
