@@ -36,9 +36,17 @@ class Outputs {
     std::error_code ec;
     std::filesystem::create_directories(scene.output.dir, ec);
     if (ec) throw InputError("cannot create the output folder '" + scene.output.dir.string() + "': " + ec.message());
+    // A folder run before holds its outputs: what a killed writer left half done goes, and so
+    // do the files this run will not write (fields of a run that had them, breaks of one with
+    // failure), so that no file of the folder is from another run than series.csv.
+    remove_stale_temporaries(scene.output.dir);
+    const bool fields = scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields;
+    std::vector<const char*> not_written;
+    if (!fields) not_written.insert(not_written.end(), {"fields.h5", "fields.xdmf"});
+    if (!scene.dem.failure_enabled()) not_written.push_back("breaks.csv");
+    for (const char* name : not_written) std::filesystem::remove(scene.output.dir / name, ec);
     series_.emplace(scene.output.dir / "series.csv", series_columns(scene));
-    if (scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields)
-      fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+    if (fields) fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
     write_file_atomically(scene.output.dir / "case.resolved.yaml", scene.resolved_case);
   }
 

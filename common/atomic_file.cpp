@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "common/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <fstream>
@@ -22,7 +23,41 @@ namespace {
   throw RunError("cannot " + std::string(what) + " '" + path.string() + "': " + why);
 }
 
+// The pid at the end of "<name>.tmp.<pid>" or "<name>.part.<pid>"; 0 if the name is not one.
+pid_t writer_pid(const std::string& name) {
+  for (const char* marker : {".tmp.", ".part."}) {
+    const std::size_t at = name.rfind(marker);
+    if (at == std::string::npos || at == 0) continue;
+    const std::string digits = name.substr(at + std::strlen(marker));
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    return static_cast<pid_t>(std::stol(digits));
+  }
+  return 0;
+}
+
+// Whether process `pid` still runs: kill(pid, 0) probes it (ESRCH: none; EPERM: alive, another
+// user's), and a zombie (killed, not yet reaped; state Z in /proc/<pid>/stat) counts as gone.
+bool process_running(pid_t pid) {
+  if (::kill(pid, 0) != 0 && errno == ESRCH) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return true;
+  const std::size_t name_end = line.rfind(')');  // the command name is in parentheses and may hold spaces
+  return name_end == std::string::npos || name_end + 2 >= line.size() || line[name_end + 2] != 'Z';
+}
+
 }  // namespace
+
+std::size_t remove_stale_temporaries(const std::filesystem::path& dir) {
+  std::size_t removed = 0;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const pid_t pid = writer_pid(entry.path().filename().string());
+    if (pid <= 0 || !entry.is_regular_file() || process_running(pid)) continue;
+    if (std::filesystem::remove(entry.path(), ec)) ++removed;
+  }
+  return removed;
+}
 
 std::filesystem::path temporary_path_for(const std::filesystem::path& path) {
   // The process id keeps writers apart (e.g. MPI ranks writing the same result file): each

@@ -114,9 +114,7 @@ struct FieldsWriter::Column {
 FieldsWriter::FieldsWriter(std::filesystem::path h5_path, std::filesystem::path xdmf_path)
     : h5_path_(std::move(h5_path)), part_path_(h5_path_), xdmf_path_(std::move(xdmf_path)) {
   part_path_ += ".part." + std::to_string(::getpid());  // one per writing process (MPI ranks)
-  h5_reference_ = xml_escaped(std::filesystem::absolute(h5_path_)
-                                  .lexically_relative(std::filesystem::absolute(xdmf_path_).parent_path())
-                                  .generic_string());
+  h5_reference_ = reference_to(part_path_);
   // Every failure becomes a RunError naming the operation; the library's own stack dump on
   // stderr would only duplicate it (this setting is process-wide, which is what we want).
   checked(H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr), part_path_, "silence error printing for", "file");
@@ -171,7 +169,18 @@ void FieldsWriter::close() {
   std::error_code ec;
   std::filesystem::rename(part_path_, h5_path_, ec);
   if (ec) throw RunError("cannot rename '" + part_path_.string() + "' to '" + h5_path_.string() + "': " + ec.message());
+  // The frames now name the renamed file ("<file>:" starts every dataset reference).
+  const std::string from = h5_reference_ + ":", to = reference_to(h5_path_) + ":";
+  for (std::size_t at = frames_xml_.find(from); at != std::string::npos; at = frames_xml_.find(from, at + to.size()))
+    frames_xml_.replace(at, from.size(), to);
+  h5_reference_ = reference_to(h5_path_);
   write_xdmf();
+}
+
+std::string FieldsWriter::reference_to(const std::filesystem::path& h5_file) const {
+  return xml_escaped(std::filesystem::absolute(h5_file)
+                         .lexically_relative(std::filesystem::absolute(xdmf_path_).parent_path())
+                         .generic_string());
 }
 
 void FieldsWriter::add_grid(const std::string& grid, std::span<const Vec3> points, CellKind kind,

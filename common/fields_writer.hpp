@@ -7,9 +7,10 @@
 //                 <grid>/connectivity             m x k int64 (1-D, m entries, for vertex cells)
 //                 <grid>/point/<name>, <grid>/cell/<name>
 //                                                 n or m (scalars), n x 3 or m x 3 (vectors)
-// While the run goes on the HDF5 file is `<h5_path>.part`; close() renames it to h5_path.
-// The XDMF is rewritten (atomically) after every frame and always names the final h5 file,
-// so a killed run is recovered by renaming the .part file.
+// While the run goes on the HDF5 file is `<h5_path>.part.<pid>`; close() renames it to h5_path.
+// The XDMF is rewritten (atomically) after every frame and names the h5 file as it is on disk:
+// the .part file until close(), h5_path after. So the frames of a killed run (SIGKILL, a
+// second Ctrl-C) open in ParaView as they are, each flushed when it ended.
 //
 // Serial HDF5 I/O: the file is created with default property lists even when the library
 // is the MPI build, and MPI is never initialised here.
@@ -98,7 +99,8 @@ class FieldsWriter {
   std::filesystem::path h5_path_;
   std::filesystem::path part_path_;
   std::filesystem::path xdmf_path_;
-  std::string h5_reference_;  // h5 file name as the XDMF refers to it (relative, XML-escaped)
+  std::string h5_reference_;  // h5 file name as the XDMF refers to it now (relative, XML-escaped)
+  std::string reference_to(const std::filesystem::path& h5_file) const;
   std::int64_t file_ = -1;    // HDF5 hid_t; -1 once closed (keeps hdf5.h/mpi.h out of includers)
   bool in_frame_ = false;
   std::size_t frame_count_ = 0;

@@ -2,11 +2,16 @@
 // The cases of cases/ run through the `arlequin` executable, checked against their references.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
 #include <algorithm>
+#include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -207,6 +212,41 @@ TEST(Cli, CheckWritesNothingNotEvenThePackingCache) {
   const auto run = test::run_arlequin("run " + (dir / "case.yaml").string() + " --quiet --out " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "results" / "small_packing" / "sample.h5"));
+}
+
+// A run killed outright (SIGKILL, a second Ctrl-C) leaves an index whose frames open: the XDMF
+// names the HDF5 file as it is on disk (the .part file until the run closes it; it named a
+// fields.h5 that did not exist). The next run into the folder removes the dead run's .part
+// and .tmp files, and a run without fields the fields of a run before.
+TEST(Cli, KilledRunLeavesReadableFieldsAndTheNextRunCleansUp) {
+  const auto out = test::scratch_dir("killed_run");
+  const std::string exe = std::string(ARLEQUIN_BINARY_DIR) + "/app/arlequin";
+  const std::string command = exe + " run " + cases + "demo_beam_impact/case.yaml --quiet --set time.end=1 --out " +
+                              out.string() + " > /dev/null 2>&1 & echo $! > " + (out / "pid").string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  const pid_t pid = static_cast<pid_t>(std::stol(test::read_text(out / "pid")));
+  std::filesystem::remove(out / "pid");
+  for (int wait = 0; wait < 600 && !std::filesystem::exists(out / "fields.xdmf"); ++wait)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  ::waitpid(pid, nullptr, 0);  // reaped by the shell already, or here: either way it is gone
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const std::string part = "fields.h5.part." + std::to_string(pid);
+  const std::string index = test::read_text(out / "fields.xdmf");
+  EXPECT_NE(index.find(part + ":/frames/"), std::string::npos) << index.substr(0, 400);
+  EXPECT_TRUE(std::filesystem::exists(out / part));
+  EXPECT_FALSE(std::filesystem::exists(out / "fields.h5"));
+
+  const auto rerun = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --steps 5 --set output.fields=[] --out " +
+                                        out.string());
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
+  for (const auto& entry : std::filesystem::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_EQ(name.find(".part."), std::string::npos) << name;
+    EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;
+    EXPECT_NE(name, "fields.xdmf");
+  }
 }
 
 TEST(Cli, SweepTabulatesErrorAgainstRunTime) {

@@ -45,6 +45,21 @@ TEST_F(OutputTest, AtomicWriteReplacesContentAndLeavesNoTemporary) {
   EXPECT_THROW(write_file_atomically(path / "below_a_file", "x"), RunError);
 }
 
+// What a killed writer left (<name>.tmp.<pid>, <name>.part.<pid> of a process that is gone) is
+// removed; a live process's temporaries and every other file stay.
+TEST_F(OutputTest, StaleTemporariesOfDeadWritersAreRemoved) {
+  const std::string own = std::to_string(::getpid()), gone = "999999999";  // above any pid_max
+  const std::vector<std::string> kept = {"series.csv.tmp." + own, "fields.h5.part." + own, "notes.txt", "a.tmp.12x",
+                                         "fields.h5"};
+  for (const std::string& name : kept) write_file_atomically(dir_ / name, "x");
+  write_file_atomically(dir_ / ("series.csv.tmp." + gone), "x");
+  write_file_atomically(dir_ / ("fields.h5.part." + gone), "x");
+  EXPECT_EQ(remove_stale_temporaries(dir_), 2u);
+  EXPECT_FALSE(fs::exists(dir_ / ("series.csv.tmp." + gone)));
+  EXPECT_FALSE(fs::exists(dir_ / ("fields.h5.part." + gone)));
+  for (const std::string& name : kept) EXPECT_TRUE(fs::exists(dir_ / name)) << name;
+}
+
 TEST_F(OutputTest, CsvSeriesRoundTrip) {
   const fs::path path = dir_ / "series.csv";
   {
@@ -160,6 +175,10 @@ TEST_F(OutputTest, FieldsWriterParticlesAndBonds) {
       EXPECT_THROW(writer.add_grid("broken", positions, FieldsWriter::CellKind::Line, out_of_range), std::logic_error);
       writer.end_frame();
       EXPECT_TRUE(fs::exists(fs::path(h5) += ".part." + std::to_string(::getpid())));
+      // While the run goes on the index names the file on disk, so a killed run's frames open.
+      const std::string part_reference = "fields.h5.part." + std::to_string(::getpid()) + ":/frames/";
+      EXPECT_NE(read_text(xdmf).find(part_reference), std::string::npos);
+      EXPECT_EQ(read_text(xdmf).find("fields.h5:"), std::string::npos);
     }
     EXPECT_THROW(writer.add_grid("late", {}, FieldsWriter::CellKind::Vertex, {}), std::logic_error);
     EXPECT_EQ(writer.frames(), 2u);
@@ -167,6 +186,7 @@ TEST_F(OutputTest, FieldsWriterParticlesAndBonds) {
   }
   EXPECT_FALSE(fs::exists(fs::path(h5) += ".part." + std::to_string(::getpid())));
   ASSERT_TRUE(fs::exists(h5));
+  EXPECT_EQ(read_text(xdmf).find(".part."), std::string::npos);
 
   const hid_t file = H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(file, 0);
