@@ -11,6 +11,7 @@
 
 #include "common/case_file.hpp"
 #include "common/error.hpp"
+#include "common/memory.hpp"
 #include "common/region.hpp"
 #include "common/schema.hpp"
 #include "dem/bonds/bond_set.hpp"
@@ -152,6 +153,18 @@ void read_packing(CaseNode sample, Scene& scene, double density, const SceneOpti
   if (options.write_sample_cache) dem::save_sample(file, p, spec, scene.sample->report);
 }
 
+// A lattice or chain of `des` DEs that cannot fit in this machine's memory is refused at `key`
+// before it is built: a DE's state takes about 200 B (dem/particles.hpp, structure of arrays)
+// and a lattice DE's three bonds at least 100 B each, so 500 B per DE is a floor.
+void refuse_beyond_memory(CaseNode& sample, const char* key, double des) {
+  constexpr double kBytesPerDe = 500.0;
+  if (const std::string beyond = beyond_memory(des * kBytesPerDe, "about 500 B per DE with its bonds"); !beyond.empty()) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.3g", des);
+    sample.fail(key, std::string("makes ") + count + " DEs, " + beyond);
+  }
+}
+
 void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
   static constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packing"};
   dem::ParticleSet& p = scene.dem.particles;
@@ -164,6 +177,7 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     if (counts.size() != 3) sample.fail("counts", "expected three DE counts [nx, ny, nz]");
     for (double c : counts)
       if (c != std::floor(c)) sample.fail("counts", "expected whole numbers");
+    refuse_beyond_memory(sample, "counts", counts[0] * counts[1] * counts[2]);
     const double radius = sample.number("radius", Range::positive(), "m");
     const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
     dem::build_lattice(p, origin, {int(counts[0]), int(counts[1]), int(counts[2])}, spacing, radius, density);
@@ -172,6 +186,7 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     const Vec3 direction = sample.vec3_or("direction", {1, 0, 0}, Range::any(), "1");
     if (!(norm(direction) > 0.0)) sample.fail("direction", "expected a non-zero direction vector");
     const auto count = sample.integer("count", Range::at_least(1));
+    refuse_beyond_memory(sample, "count", double(count));
     const double radius = sample.number("radius", Range::positive(), "m");
     const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
     dem::build_chain(p, start, normalized(direction), int(count), spacing, radius, density);

@@ -15,6 +15,7 @@
 #include <unordered_map>
 
 #include "common/error.hpp"
+#include "common/memory.hpp"
 
 namespace arlequin::continuum {
 
@@ -104,6 +105,17 @@ Mesh Mesh::load(const MeshSource& source) {
     gmsh::open(source.path);
     if (ext == ".geo") {
       if (source.size > 0.0) {
+        // Meshing a body at a size far below its extent would run for hours and then fail to
+        // allocate: refuse it first. About one node per h^3 of the bounding box, and at least
+        // 1 kB per node for gmsh's mesh and the solver's rows.
+        double lo[3], hi[3];
+        gmsh::model::getBoundingBox(-1, -1, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+        const double nodes = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]) / std::pow(source.size, 3);
+        if (const std::string beyond = beyond_memory(nodes * 1e3, "about 1 kB per node"); !beyond.empty()) {
+          char text[64];
+          std::snprintf(text, sizeof text, " at size %g m makes about %.3g nodes, ", source.size, nodes);
+          throw InputError("meshing " + source.path + text + beyond);
+        }
         gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
         gmsh::option::setNumber("Mesh.MeshSizeMin", source.size);
         gmsh::option::setNumber("Mesh.MeshSizeMax", source.size);
@@ -113,6 +125,8 @@ Mesh Mesh::load(const MeshSource& source) {
       gmsh::model::mesh::generate(3);
       if (source.order == 2) gmsh::model::mesh::setOrder(2);
     }
+  } catch (const InputError&) {
+    throw;
   } catch (const std::exception& e) {
     throw InputError("gmsh could not mesh/read " + source.path + ": " + e.what());
   } catch (const std::string& message) {  // gmsh 4.8 throws its error message as a std::string

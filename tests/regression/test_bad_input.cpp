@@ -152,6 +152,10 @@ INSTANTIATE_TEST_SUITE_P(
         // The name is the output folder's last component: no way out of results/, no NUL.
         BadInput{"name_leaving_results", 1, "name: ../../..", "", {"case.yaml:1", "name", "results/<name>"}},
         BadInput{"name_with_a_nul", 1, "name: \"a\\0b\"", "", {"case.yaml:1", "name", "results/<name>"}},
+        // Far beyond this machine's memory: refused before anything is built (it ended in
+        // std::bad_alloc, exit 4).
+        BadInput{"chain_beyond_memory", 5, "  sample: {build: chain, count: 1000000000000, radius: 1.0e-3}", "",
+                 {"case.yaml:5", "dem.sample.count", "1e+12 DEs", "this machine has"}},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
         BadInput{"override_out_of_range", 0, "", "--set time.safety=2", {"--set time.safety=2", "time.safety"}},
         BadInput{"unknown_option", 0, "", "--stpes 3", {"unknown option '--stpes'"}}),
@@ -191,6 +195,19 @@ TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
   }
   const auto r = test::run_arlequin("check " + bar + " --set continuum.mesh.file=" + (dir / "syntax.geo").string());
   EXPECT_NE(r.output.find("line 1"), std::string::npos) << r.output;
+}
+
+// A mesh size far below the body's extent is refused before meshing (it ran for hours, silent).
+TEST(BadInput, MeshBeyondMemoryIsRefusedBeforeMeshing) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto r = test::run_arlequin("check " + std::string(ARLEQUIN_SOURCE_DIR) +
+                                    "/cases/bar_wave_continuum/case.yaml --set continuum.mesh.size=1e-5");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  for (const char* s : {"continuum.mesh", "size 1e-05 m", "1e+13 nodes", "this machine has"})
+    EXPECT_NE(r.output.find(s), std::string::npos) << "missing '" << s << "' in: " << r.output;
 }
 
 // The continuum's PETSc options are checked before the run, as the coupling's are: an option

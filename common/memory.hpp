@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// What a case would need against what the machine has: a case far beyond the memory is refused
+// before anything is allocated (a bad_alloc mid-build, or minutes of meshing, says nothing useful).
+#pragma once
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+namespace arlequin {
+
+// Physical memory of this machine, bytes (0 if the system does not say).
+inline double physical_memory_bytes() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+}
+
+// "12.3 GB" (decimal units).
+inline std::string gigabytes(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g GB", bytes / 1e9);
+  return text;
+}
+
+// Empty if `bytes` fits in the physical memory (or it is unknown); else the sentence to add to
+// an error: "which needs at least X (WHY); this machine has Y".
+inline std::string beyond_memory(double bytes, const std::string& why) {
+  const double have = physical_memory_bytes();
+  if (have <= 0.0 || bytes <= have) return {};
+  return "which needs at least " + gigabytes(bytes) + " (" + why + "); this machine has " + gigabytes(have);
+}
+
+}  // namespace arlequin
