@@ -134,8 +134,15 @@ double DemModel::critical_time_step() const {
   // docs/theory.md#critical-step): dt_c = 4 / (c + sqrt(c^2 + 4 omega^2)), which is 2/omega
   // undamped (to the bit) and 2/c for a DE without bonds.
   const double c = damping_;
-  if (!(omega2 > 0.0) && !(c > 0.0)) return std::numeric_limits<double>::infinity();
-  return 4.0 / (c + std::sqrt(c * c + 4.0 * omega2));
+  double dt_c = !(omega2 > 0.0) && !(c > 0.0) ? std::numeric_limits<double>::infinity()
+                                               : 4.0 / (c + std::sqrt(c * c + 4.0 * omega2));
+  // With contact, a DE that moves more than its radius in a step can pass through another
+  // unseen: the step is also bounded by R_i / |v_i| at the present speeds (check_finite stops a
+  // run whose DEs later move faster than that).
+  if (contact_)
+    for (std::size_t i = 0; i < n; ++i)
+      if (const double speed = norm(particles.velocity[i]); speed > 0.0) dt_c = std::min(dt_c, particles.radius[i] / speed);
+  return dt_c;
 }
 
 void DemModel::step(double dt) {
@@ -244,7 +251,9 @@ void DemModel::update_neighbours() {
 double DemModel::compute_forces(const ForceScan& scan) {
   particles.clear_forces();
   for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
-  return contact_ ? contact_->accumulate_forces(*neighbours_, particles) : 0.0;
+  if (!contact_) return 0.0;
+  deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles);
+  return deepest_contact_.friction_power;
 }
 
 ForceScan DemModel::failure_scan() {
@@ -434,6 +443,7 @@ void DemModel::check_finite() const {
     if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
       if (bad++ == 0) first = i;
     }
+  if (bad == 0 && contact_) check_contact_resolution();
   if (bad == 0) return;
   std::ostringstream msg;
   msg << "step " << steps_ << " (t = " << time_ << " s): " << bad << " DE(s) have a non-finite velocity, "
@@ -441,6 +451,34 @@ void DemModel::check_finite() const {
       << p.reference[first].z << ") m; likely cause: a time step above the stability limit, or an initial "
          "overlap far too deep for the contact stiffness";
   throw RunError(msg.str());
+}
+
+void DemModel::check_contact_resolution() const {
+  const ParticleSet& p = particles;
+  std::ostringstream msg;
+  msg << "step " << steps_ << " (t = " << time_ << " s): ";
+  // The fastest DE against its radius: moving more than R in a step it can cross a contact
+  // without the contact ever seeing it.
+  std::size_t fastest = 0;
+  double reach = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > reach) reach = r, fastest = i;
+  if (reach > 1.0) {
+    msg << "DE " << fastest << " at (" << p.position[fastest].x << ", " << p.position[fastest].y << ", "
+        << p.position[fastest].z << ") m moves " << reach << " of its radius per step (" << norm(p.velocity[fastest])
+        << " m/s): a contact can be crossed unseen; lower the time step (time.safety or time.dt) below "
+        << p.radius[fastest] / norm(p.velocity[fastest]) << " s";
+    throw RunError(msg.str());
+  }
+  // The penalty holds an impact only if the overlap stays well inside the spheres.
+  const ContactPass& c = deepest_contact_;
+  if (c.deepest > 1.0) {
+    msg << "the contact of DEs " << c.first << " and " << c.second << " overlaps " << c.deepest
+        << " of the smaller radius: the contact stiffness (" << contact_->stiffness()
+        << " N/m) is too soft to stop this impact within the spheres (an impact of energy E needs about "
+           "K >= 2 E / R^2); raise dem.contact.stiffness";
+    throw RunError(msg.str());
+  }
 }
 
 void DemModel::check_energy(double energy_limit) const {

@@ -73,8 +73,9 @@ class DemModel {
   void finalize();
 
   // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
-  // bonds and contacts (docs/theory.md#critical-step). Contacts count as many per DE as it has
-  // neighbours at setup (at least one), with the stiffness of the contact law.
+  // bonds and contacts, lowered by damping (docs/theory.md#critical-step). Contacts count as
+  // many per DE as it has neighbours at setup (at least one), with the stiffness of the contact
+  // law; with contact, no DE may move more than its radius in a step at its present speed.
   double critical_time_step() const;
 
   // One velocity-Verlet step of size dt (s): the phases, in order. step() is
@@ -109,9 +110,11 @@ class DemModel {
   Vec3 mean_velocity(int group) const;      // m/s
   // Kinetic energy of the group's DEs plus half the energy of each of their bonds, J.
   double group_energy(int group) const;
-  // Both throw RunError naming the step, the DE and the likely cause. check_finite: any
-  // non-finite velocity (cheap, meant for every step); check_energy: kinetic energy above
-  // energy_limit (J), a blow-up.
+  // Both throw RunError naming the step, the DE and the likely cause. check_finite (cheap,
+  // meant for every step): any non-finite velocity; with contact, also a DE that moved more
+  // than its radius in the last step (it can pass through another) or a contact deeper than
+  // the pair's smaller radius (a penalty too soft for the impact). check_energy: kinetic
+  // energy above energy_limit (J), a blow-up.
   void check_finite() const;
   void check_energy(double energy_limit) const;
   // The kinetic energy of every DE moving at eps X / time (eps: machine epsilon; X: the largest
@@ -127,6 +130,7 @@ class DemModel {
   void drift(double dt);
   void update_neighbours();
   double compute_forces(const ForceScan& scan = {});  // returns the friction's power, W
+  void check_contact_resolution() const;              // check_finite's contact part
   // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();
@@ -147,6 +151,7 @@ class DemModel {
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
   std::unique_ptr<ContactLaw> contact_;
   std::optional<NeighbourList> neighbours_;
+  ContactPass deepest_contact_;  // of the last force pass
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)

@@ -16,6 +16,7 @@
 // sliding faster than v_slip, viscous below it (no history, so the neighbour list can be
 // rebuilt freely); it acts at the contact point, hence torques. Its power is returned.
 #pragma once
+#include <algorithm>
 #include <cmath>
 
 #include "dem/contacts/contact_law.hpp"
@@ -27,9 +28,9 @@ class ContactKernelLaw : public ContactLaw {
  public:
   std::string_view law() const override { return Law::name; }
 
-  double accumulate_forces(const NeighbourList& list, ParticleSet& p) const override {
+  ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p) const override {
     const double mu = self().friction();
-    double power = 0.0;
+    ContactPass pass;
     for (auto [i, j] : list.pairs()) {
       const Vec3 d = p.position[j] - p.position[i];
       const double reach = p.radius[i] + p.radius[j];
@@ -39,9 +40,11 @@ class ContactKernelLaw : public ContactLaw {
       const Vec3 f_j = self().force_on_j(d, distance, reach);
       p.force[i] -= f_j;
       p.force[j] += f_j;
-      if (mu > 0.0) power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
+      if (mu > 0.0) pass.friction_power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
+      const double depth = (reach - distance) / std::min(p.radius[i], p.radius[j]);
+      if (depth > pass.deepest) pass = {pass.friction_power, depth, i, j};
     }
-    return power;
+    return pass;
   }
 
   double energy(const NeighbourList& list, const ParticleSet& p) const override {

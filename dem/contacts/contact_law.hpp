@@ -3,10 +3,12 @@
 //
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually
 // touching (|x_i - x_j| < R_i + R_j) and returns the power its friction dissipates at the
-// present velocities (W, >= 0; 0 for a frictionless law); energy() is the elastic energy of
+// present velocities (W, >= 0; 0 for a frictionless law) and the deepest contact (its overlap
+// over the pair's smaller radius, and the pair); energy() is the elastic energy of
 // those contacts; stiffness() is the largest normal stiffness a contact can have (N/m), for the
 // critical time step. One virtual call per batch of pairs, none per pair.
 #pragma once
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string_view>
@@ -21,11 +23,18 @@ class CaseNode;
 
 namespace arlequin::dem {
 
+// What one contact pass found besides its forces.
+struct ContactPass {
+  double friction_power = 0.0;  // W, >= 0
+  double deepest = 0.0;         // largest overlap / min(R_i, R_j) over the touching pairs
+  std::uint32_t first = 0, second = 0;  // that pair
+};
+
 class ContactLaw {
  public:
   virtual ~ContactLaw() = default;
   virtual std::string_view law() const = 0;
-  virtual double accumulate_forces(const NeighbourList& list, ParticleSet& p) const = 0;
+  virtual ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p) const = 0;
   virtual double energy(const NeighbourList& list, const ParticleSet& p) const = 0;
   virtual double stiffness() const = 0;
 };

@@ -436,6 +436,26 @@ TEST(Cases, APlotThatCannotBeDrawnIsSkippedInOneLine) {
 
 // BBF in a structure: a simple-cubic lattice bar fails at 36 S sigma_f (the case's own check),
 // its breaks are recorded, and the fracture energy closes the energy balance.
+// The demo's ball at 2e5 m/s moved 19 mm per step and went through the beam unseen, and at
+// 2000 m/s the penalty (2e7 N/m) could not stop it within the beam: both passed silently. Now
+// the critical step keeps the ball within its radius per step, and the too-soft contact stops
+// the run naming the pair.
+TEST(Cases, FastImpactIsResolvedOrStopped) {
+  for (const std::string speed : {"2e5", "2000"}) {
+    const auto out = test::scratch_dir("fast_impact_" + speed);
+    const auto r = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --set output.fields=[] --set time.end=2e-4 "
+                                      "--set \"dem.sample.particles=[{position: [0.05, 0.003, 0.0115], radius: 0.003, "
+                                      "velocity: [0, 0, -" + speed + "]}]\" --out " + out.string());
+    EXPECT_NE(r.exit_code, 0) << r.output;
+    const Json s = read_json_file(out / "summary.json");
+    EXPECT_EQ(s.at("status").get<std::string>(), "failed");
+    EXPECT_NE(s.at("error").get<std::string>().find("too soft to stop this impact"), std::string::npos) << s.dump();
+    if (speed == "2e5") {
+      EXPECT_LE(s.at("dt_critical").get<double>(), 0.003 / 2e5);
+    }
+  }
+}
+
 // Heavy damping (c dt up to 3.3 at the undamped step's 0.1) blew up with a message that blamed
 // the bonds: the critical step now includes the damping (dt^2 omega^2 + 2 c dt < 4), so the run
 // completes, and a step above the damped limit is refused saying so.
@@ -715,7 +735,9 @@ TEST(Runner, NonFiniteStateStopsTheRunAndKeepsOutputs) {
 // cause, before any velocity is non-finite. (From rest: Runs.UnstableStepOnAPackingAtRestIsABlowUp.)
 TEST(Runner, UnstableStepStopsTheRunAsABlowUp) {
   const auto out = test::scratch_dir("blow_up");
-  app::Scene scene = app::build_scene(cases + "demo_beam_impact/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
+  // A bonded scene without contact: with contact the step check stops a DE that moves more than
+  // its radius per step first (PenaltyContact.TooFastOrTooSoftStopsTheRun).
+  app::Scene scene = app::build_scene(cases + "cantilever_chain/case.yaml", {.overrides = {}, .out_dir = out, .petsc_options = ""});
   scene.dt = 2.5 * scene.dt_critical;
   app::RunOptions options;
   options.max_steps = 5000;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "common/error.hpp"
 #include "dem/contacts/penalty_contact.hpp"
 #include "support/dem_fixtures.hpp"
 
@@ -182,6 +183,45 @@ TEST(PenaltyContact, HeadOnImpactConservesEnergy) {
   EXPECT_LT(worst, 1e-3 * e0);
 }
 
+// The head-on pair made too fast or too soft for its contact (docs/theory.md#critical-step):
+// the critical step keeps a DE within its radius per step at its speed, a run forced past that
+// stops naming the DE, and an overlap beyond the smaller radius (the penalty cannot stop the
+// impact: K delta^2 / 2 < m v^2 / 2 with delta = R) stops naming the pair. Both passed silently.
+TEST(PenaltyContact, TooFastOrTooSoftStopsTheRun) {
+  const double R = 1e-3, v = 1e3;  // m, m/s
+  const auto pair = [&](double K, double gap) {
+    auto model = std::make_unique<DemModel>();
+    model->particles.add({0, 0, 0}, R, steel);
+    model->particles.add({2 * R + gap, 0, 0}, R, steel);
+    model->particles.velocity[0] = {v, 0, 0};
+    model->set_contact(std::make_unique<PenaltyContact>(K), 0.2 * R);
+    model->finalize();
+    return model;
+  };
+  auto fast = pair(1e6, 10 * R);  // not in contact during the step
+  EXPECT_LE(fast->critical_time_step(), R / v);
+  fast->step(2.5 * R / v);
+  try {
+    fast->check_finite();
+    FAIL() << "a DE moving 2.5 radii per step was not stopped";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("moves 2.5 of its radius per step"), std::string::npos) << e.what();
+  }
+  // m v^2 = 0.033 J, K R^2 = 1e-4 J: the spheres go through each other.
+  auto soft = pair(100.0, 1e-4);
+  const double dt = 0.3 * soft->critical_time_step();
+  try {
+    for (int n = 0; n < 100; ++n) {
+      soft->step(dt);
+      soft->check_finite();
+    }
+    FAIL() << "an overlap beyond the radius was not stopped";
+  } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("the contact of DEs 0 and 1 overlaps"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("too soft"), std::string::npos) << e.what();
+  }
+}
+
 // Friction (docs/theory.md#contact-friction): DE 1 overlaps the resting DE 0 by delta and slides
 // past it along y at v. Sliding faster than v_slip: F_t = -mu K delta y on DE 1, applied at the
 // contact point, delta/2 inside each sphere, so its torque is (-(R - delta/2) x) x F_t (and the
@@ -198,7 +238,7 @@ TEST(PenaltyContact, FrictionOpposesSlidingWithTheCoulombForce) {
     list.build(p);
     const PenaltyContact law(K, mu, v_slip);
     p.clear_forces();
-    const double power = law.accumulate_forces(list, p);
+    const double power = law.accumulate_forces(list, p).friction_power;
     const double f_t = mu * K * delta * std::min(1.0, v / v_slip);
     EXPECT_NEAR(p.force[1].x, K * delta, 1e-9 * K * delta);
     EXPECT_NEAR(p.force[1].y, -f_t, 1e-9 * f_t);
