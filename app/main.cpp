@@ -252,8 +252,8 @@ int run(const Arguments& a) {
   options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   print_scene_facts(scene);
   const app::RunResult r = app::run_scene(scene, options);
-  std::printf("done: %ld steps, t = %.6e s, wall %.3f s (%.0f steps/s), setup %.3f s\n", r.steps, r.simulated_time,
-              r.wall_seconds, r.steps / std::max(r.wall_seconds, 1e-9), options.setup_seconds);
+  std::printf("done: %ld steps, t = %.6e s, wall %.3f s (output %.3f s; %.0f steps/s without output), setup %.3f s\n",
+              r.steps, r.simulated_time, r.wall_seconds, r.output_seconds, app::steps_per_second(r), options.setup_seconds);
   const auto& e = r.energies;
   std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e  fracture %.6e\n",
               e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture);

@@ -258,6 +258,8 @@ Json energies_json(const dem::Energies& e) {
 
 }  // namespace
 
+double steps_per_second(const RunResult& r) { return r.steps / std::max(r.wall_seconds - r.output_seconds, 1e-9); }
+
 const char* describe(Check::Kind kind) {
   switch (kind) {
     case Check::Kind::final_value: return "final value";
@@ -408,6 +410,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   result.steps = steps_done;
   result.simulated_time = current_time();
   result.wall_seconds = seconds_since(t_start);
+  result.output_seconds = output_seconds;
   outputs.close();
   outputs.write_plots();
 
@@ -440,7 +443,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   wall["setup"] = options.setup_seconds;
   wall["time_loop"] = result.wall_seconds;
   wall["output"] = output_seconds;
-  wall["steps_per_second"] = result.steps / std::max(result.wall_seconds - output_seconds, 1e-9);
+  wall["steps_per_second"] = steps_per_second(result);
   summary["energies"] = energies_json(result.energies);
   // The checks are stated for the whole case: a run cut short by --steps is not judged.
   if (failure.empty() && !scene.checks.empty() && !static_only && options.max_steps >= 0 && options.max_steps < scene.steps)

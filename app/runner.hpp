@@ -32,6 +32,7 @@ struct RunResult {
   long steps = 0;
   double simulated_time = 0.0;  // s
   double wall_seconds = 0.0;    // time loop only
+  double output_seconds = 0.0;  // of which writing outputs (rows, frames)
   dem::Energies energies;
   std::vector<std::pair<std::string, double>> sensors;  // last value of each column
   std::string stop_reason;      // why stop_after_row ended the run early (empty: it did not)
@@ -51,5 +52,7 @@ struct RunResult {
 RunResult run_scene(Scene& scene, const RunOptions& options);
 
 const char* describe(Check::Kind kind);  // "final value", "maximum", ...
+// Steps per second of the time loop without its output (summary.json's and the closing line's).
+double steps_per_second(const RunResult& r);
 
 }  // namespace arlequin::app

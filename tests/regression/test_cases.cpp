@@ -456,6 +456,21 @@ TEST(Cases, FastImpactIsResolvedOrStopped) {
   }
 }
 
+// A run shorter than one step is one step of time.end (the calibration's placeholder packing,
+// E_mu = 1 Pa, ran 750 times past its time.end), and the closing line's steps/s is the summary's.
+TEST(Cases, RunShorterThanAStepEndsAtTimeEnd) {
+  const auto out = test::scratch_dir("shorter_than_a_step");
+  const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --set time.end=1e-12 --out " + out.string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json s = read_json_file(out / "summary.json");
+  EXPECT_EQ(s.at("steps").get<long>(), 1);
+  EXPECT_EQ(s.at("simulated_time").get<double>(), 1e-12);
+  EXPECT_EQ(s.at("dt").get<double>(), 1e-12);
+  char rate[64];
+  std::snprintf(rate, sizeof rate, "%.0f steps/s without output", s.at("wall_time").at("steps_per_second").get<double>());
+  EXPECT_NE(r.output.find(rate), std::string::npos) << r.output;
+}
+
 // Heavy damping (c dt up to 3.3 at the undamped step's 0.1) blew up with a message that blamed
 // the bonds: the critical step now includes the damping (dt^2 omega^2 + 2 c dt < 4), so the run
 // completes, and a step above the damped limit is refused saying so.
