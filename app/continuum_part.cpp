@@ -362,6 +362,8 @@ class Part final : public ContinuumPart {
   }
   double kinetic_energy() const override { return solver_->kinetic_energy(); }
   double strain_energy() const override { return solver_->strain_energy(); }
+  double external_work() const override { return solver_->external_work(); }
+  double verlet_correction(double dt) const override { return solver_->verlet_correction(dt); }
 
   void write_fields(FieldsWriter& fields) const override {
     const auto& mesh = solver_->mesh();

@@ -71,6 +71,10 @@ class ContinuumPart {
   virtual std::array<double, 2> affine_deviation(const std::array<Vec3, 3>& H) const = 0;
   virtual double kinetic_energy() const = 0;
   virtual double strain_energy() const = 0;
+  // Work of the tractions and moving supports over the steps of step(), J, and velocity
+  // Verlet's shadow correction at step dt (ContinuumSolver::external_work, verlet_correction).
+  virtual double external_work() const = 0;
+  virtual double verlet_correction(double dt) const = 0;
   virtual void write_fields(FieldsWriter& fields) const = 0;
   virtual void describe(Json& counts) const = 0;
 };

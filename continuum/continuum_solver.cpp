@@ -356,13 +356,45 @@ void ContinuumSolver::drift(double dt) {
 }
 
 void ContinuumSolver::step(double dt) {
+  // The work of the tractions and of the supports over the step (external_work()); with no
+  // traction and no prescribed dof there is none and no pass is made.
+  const bool loaded = !tractions_.empty() || !fixed_.empty();
+  double work = 0.0;
+  if (loaded) {
+    step_u_ = u_;
+    step_f_ext_.assign(u_.size(), 0.0);
+    add_external_force(step_f_ext_);
+    step_f_fixed_.resize(fixed_.size());
+    for (std::size_t k = 0; k < fixed_.size(); ++k) {
+      const int d = fixed_[k].dof;
+      work -= 0.5 * mass_[d / 3] * v_[d] * v_[d];
+      step_f_fixed_[k] = f_[d];
+    }
+  }
   kick(0.5 * dt);
   drift(dt);
   compute_forces();
   kick(0.5 * dt);
+  if (loaded) {
+    step_f_ext_new_.assign(u_.size(), 0.0);
+    add_external_force(step_f_ext_new_);
+    for (std::size_t d = 0; d < u_.size(); ++d) work += 0.5 * (step_f_ext_[d] + step_f_ext_new_[d]) * (u_[d] - step_u_[d]);
+    for (std::size_t k = 0; k < fixed_.size(); ++k) {
+      const int d = fixed_[k].dof;
+      work += 0.5 * mass_[d / 3] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_u_[d]);
+    }
+    external_work_ += work;
+  }
   double sum = 0;
   for (double v : v_) sum += v;
   if (!std::isfinite(sum)) throw RunError("continuum: non-finite state at t = " + std::to_string(t_));
+}
+
+double ContinuumSolver::verlet_correction(double dt) const {
+  double sum = 0.0;
+  for (std::size_t d = 0; d < f_.size(); ++d)
+    if (!is_fixed_[d]) sum += f_[d] * f_[d] / mass_[d / 3];
+  return dt * dt / 8.0 * sum;
 }
 
 // Largest eigenvalue of the symmetric M^-1/2 K M^-1/2 by power iteration with the Rayleigh

@@ -114,8 +114,19 @@ class ContinuumSolver {
   void compute_forces();
   void kick(double dt);   // v += dt M^-1 f on free components
   void drift(double dt);  // u += dt v on free components; t += dt; fixed ones follow g
+  // One velocity-Verlet step; it also adds the step's external work (external_work()).
   void step(double dt);
   double critical_time_step() const;
+
+  // Work done on the continuum by its tractions and its moving supports over the steps of
+  // step() (not by a coupled step's kick and drift), J: per step, the prescribed dofs' kinetic
+  // energy change + 1/2 (f_ext + f_ext').du - 1/2 (f + f')_prescribed.du_prescribed, which with
+  // verlet_correction() makes the discrete energy balance exact for linear elasticity
+  // (docs/theory.md#energy).
+  double external_work() const { return external_work_; }
+  // (dt^2 / 8) sum over the free dofs of f^2 / m, J: velocity Verlet conserves, without external
+  // work, kinetic + strain energy minus this (the step's shadow energy of a linear system).
+  double verlet_correction(double dt) const;
 
   // Static equilibrium at the current time; leaves u solved, v untouched, forces updated.
   void solve_static(const std::string& petsc_options = "");
@@ -210,6 +221,9 @@ class ContinuumSolver {
   std::vector<Traction> tractions_;
   Field u_, v_, f_;
   double t_ = 0.0;
+  double external_work_ = 0.0;
+  // step()'s scratch: u, f_ext and the prescribed dofs' f at the step's start, f_ext at its end.
+  Field step_u_, step_f_ext_, step_f_ext_new_, step_f_fixed_;
 };
 
 }  // namespace arlequin::continuum
