@@ -249,6 +249,7 @@ int run(const Arguments& a) {
   app::RunOptions options;
   options.max_steps = a.steps;
   options.show_progress = !a.quiet && isatty(STDERR_FILENO) && std::getenv("CI") == nullptr;
+  options.announce_run_time = !a.quiet;
   options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   print_scene_facts(scene);
   const app::RunResult r = app::run_scene(scene, options);

@@ -236,10 +236,20 @@ class Outputs {
 };
 
 // A progress line on stderr, at most twice a second: step, simulated time, rate, ETA.
+// Without the line (output not a terminal, a CI log), a run that will take more than a minute
+// says once, after 2 s, how long it will take: a time.end of 1e10 steps is not a silent hang.
 class Progress {
  public:
-  Progress(bool enabled, long total) : enabled_(enabled), total_(total), start_(Clock::now()), last_(start_) {}
+  Progress(bool enabled, bool announce, long total)
+      : enabled_(enabled), announce_(announce && !enabled), total_(total), start_(Clock::now()), last_(start_) {}
   void update(long step, double t) {
+    if (announce_ && seconds_since(start_) > 2.0) {
+      announce_ = false;
+      const double rate = step / seconds_since(start_), left = (total_ - step) / std::max(rate, 1e-9);
+      if (left > 60.0)
+        std::fprintf(stderr, "  run time: about %.3g %s to go at %.0f steps/s (%ld of %ld steps done)\n",
+                     left < 3600.0 ? left / 60.0 : left / 3600.0, left < 3600.0 ? "min" : "h", rate, step, total_);
+    }
     if (!enabled_ || seconds_since(last_) < 0.5) return;
     last_ = Clock::now();
     const double elapsed = seconds_since(start_);
@@ -253,7 +263,7 @@ class Progress {
   }
 
  private:
-  bool enabled_;
+  bool enabled_, announce_;
   long total_;
   Clock::time_point start_, last_;
 };
@@ -345,7 +355,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
   Outputs outputs(scene);
-  Progress progress(options.show_progress, total_steps);
+  Progress progress(options.show_progress, options.announce_run_time, total_steps);
   RunResult result;
   const double initial_total = scene.model->energies().total() - continuum_balance_terms(scene).second;
   // A healthy run's kinetic energy stays below what it started with plus the work put in;

@@ -21,6 +21,7 @@ namespace arlequin::app {
 struct RunOptions {
   long max_steps = -1;         // --steps N: stop after N steps (< 0: run to the end time)
   bool show_progress = false;  // progress line on stderr (a terminal, not CI)
+  bool announce_run_time = false;  // without that line: one line on stderr if the run will last over a minute
   double setup_seconds = 0.0;  // wall time spent building the scene, for the summary
   // Called after each series.csv row with the row's sensor values (column, value); a
   // non-empty answer ends the run there as completed, with that reason in the summary

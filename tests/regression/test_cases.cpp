@@ -456,6 +456,19 @@ TEST(Cases, FastImpactIsResolvedOrStopped) {
   }
 }
 
+// A run that will last more than a minute says so once, after 2 s, even where no progress line
+// is drawn (a log): a time.end of 1e10 steps ran on without a word. Stopped after 4 s.
+TEST(Cases, LongRunAnnouncesItsRunTime) {
+  const auto out = test::scratch_dir("long_run");
+  const std::string command = "timeout 4 " + std::string(ARLEQUIN_BINARY_DIR) + "/app/arlequin run " + cases +
+                              "cantilever_chain/case.yaml --set output.fields=[] --set time.end=1000 --out " + out.string() +
+                              " > /dev/null 2> " + (out / "stderr.txt").string();
+  EXPECT_NE(std::system(command.c_str()), 0);  // cut by the timeout
+  const std::string err = test::read_text(out / "stderr.txt");
+  EXPECT_EQ(err.rfind("  run time: about ", 0), 0u) << err;
+  EXPECT_NE(err.find(" to go at "), std::string::npos) << err;
+}
+
 // A run shorter than one step is one step of time.end (the calibration's placeholder packing,
 // E_mu = 1 Pa, ran 750 times past its time.end), and the closing line's steps/s is the summary's.
 TEST(Cases, RunShorterThanAStepEndsAtTimeEnd) {
