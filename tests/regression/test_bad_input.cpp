@@ -154,6 +154,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"name_with_a_nul", 1, "name: \"a\\0b\"", "", {"case.yaml:1", "name", "results/<name>"}},
         // Far beyond this machine's memory: refused before anything is built (it ended in
         // std::bad_alloc, exit 4).
+        BadInput{"lattice_beyond_memory", 5, "  sample: {build: lattice, counts: [2000, 2000, 2000], radius: 1.0e-3}", "",
+                 {"case.yaml:5", "dem.sample.counts", "8e+09 DEs", "this machine has"}},
         BadInput{"chain_beyond_memory", 5, "  sample: {build: chain, count: 1000000000000, radius: 1.0e-3}", "",
                  {"case.yaml:5", "dem.sample.count", "1e+12 DEs", "this machine has"}},
         BadInput{"malformed_override", 0, "", "--set time.end", {"--set time.end"}},
