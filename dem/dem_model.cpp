@@ -438,12 +438,16 @@ Vec3 DemModel::mean_velocity(int group) const {
 
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
-  std::size_t bad = 0, first = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
+  std::size_t bad = 0, first = 0, fastest = 0;
+  double reach = 0.0;  // with contact: the largest distance a DE moved in the last step, over its radius
+  for (std::size_t i = 0; i < p.size(); ++i) {
     if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
       if (bad++ == 0) first = i;
     }
-  if (bad == 0 && contact_) check_contact_resolution();
+    if (contact_)
+      if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > reach) reach = r, fastest = i;
+  }
+  if (bad == 0 && contact_) check_contact_resolution(fastest, reach);
   if (bad == 0) return;
   std::ostringstream msg;
   msg << "step " << steps_ << " (t = " << time_ << " s): " << bad << " DE(s) have a non-finite velocity, "
@@ -453,32 +457,25 @@ void DemModel::check_finite() const {
   throw RunError(msg.str());
 }
 
-void DemModel::check_contact_resolution() const {
+void DemModel::check_contact_resolution(std::size_t fastest, double reach) const {
+  // Moving more than its radius in a step, a DE can cross a contact without the contact ever
+  // seeing it; and the penalty holds an impact only if the overlap stays inside the spheres.
+  const ContactPass& c = deepest_contact_;
+  if (reach <= 1.0 && c.deepest <= 1.0) return;
   const ParticleSet& p = particles;
   std::ostringstream msg;
   msg << "step " << steps_ << " (t = " << time_ << " s): ";
-  // The fastest DE against its radius: moving more than R in a step it can cross a contact
-  // without the contact ever seeing it.
-  std::size_t fastest = 0;
-  double reach = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > reach) reach = r, fastest = i;
-  if (reach > 1.0) {
+  if (reach > 1.0)
     msg << "DE " << fastest << " at (" << p.position[fastest].x << ", " << p.position[fastest].y << ", "
         << p.position[fastest].z << ") m moves " << reach << " of its radius per step (" << norm(p.velocity[fastest])
         << " m/s): a contact can be crossed unseen; lower the time step (time.safety or time.dt) below "
         << p.radius[fastest] / norm(p.velocity[fastest]) << " s";
-    throw RunError(msg.str());
-  }
-  // The penalty holds an impact only if the overlap stays well inside the spheres.
-  const ContactPass& c = deepest_contact_;
-  if (c.deepest > 1.0) {
+  else
     msg << "the contact of DEs " << c.first << " and " << c.second << " overlaps " << c.deepest
         << " of the smaller radius: the contact stiffness (" << contact_->stiffness()
         << " N/m) is too soft to stop this impact within the spheres (an impact of energy E needs about "
            "K >= 2 E / R^2); raise dem.contact.stiffness";
-    throw RunError(msg.str());
-  }
+  throw RunError(msg.str());
 }
 
 void DemModel::check_energy(double energy_limit) const {

@@ -130,7 +130,8 @@ class DemModel {
   void drift(double dt);
   void update_neighbours();
   double compute_forces(const ForceScan& scan = {});  // returns the friction's power, W
-  void check_contact_resolution() const;              // check_finite's contact part
+  // check_finite's contact part, given the DE that moved furthest over its radius in the last step.
+  void check_contact_resolution(std::size_t fastest, double reach) const;
   // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();
