@@ -3,12 +3,14 @@
 #include "app/scene_readers.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.hpp"
 #include "common/case_file.hpp"
 #include "common/error.hpp"
 #include "common/memory.hpp"
@@ -43,6 +45,8 @@ constexpr KeyDoc sample_keys[] = {
     {"direction", KeyType::vec3, "1", {}, "[1, 0, 0]", "direction of the chain"},
     {"count", KeyType::integer, "", Range::at_least(1), "", "DEs in the chain"},
     {"particles", KeyType::list, "", {}, "", "the DEs one by one (particles)"},
+    {"table", KeyType::file, "", {}, "(none)",
+     "particles: a CSV of the DEs, header x,y,z,radius[,vx,vy,vz], one DE per row (m, m/s), relative to the case"},
     {"region", KeyType::section, "", {}, "", "the region the packing fills (a region: box, cylinder, sphere)"},
     {"compaction", KeyType::number, "1", Range::open_between(0, 0.7), "0.63", "target solid fraction of the packing"},
     {"min_coordination", KeyType::number, "1", Range::non_negative(), "6", "mean number of bonded neighbours the packing must reach"},
@@ -165,6 +169,47 @@ void refuse_beyond_memory(CaseNode& sample, const char* key, double des) {
   }
 }
 
+// build: particles, table: FILE.csv. Header x,y,z,radius with optional vx,vy,vz (in that
+// order); each further line one DE. InputError at FILE:LINE for a row that is not those numbers.
+void read_particle_table(CaseNode& sample, Scene& scene, double density) {
+  const std::filesystem::path file = sample.existing_file("table");
+  const std::string text = read_text_file(file);
+  dem::ParticleSet& p = scene.dem.particles;
+  std::size_t line_no = 0, columns = 0;
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view line(text.data() + at, end - at);
+    at = end + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty()) continue;
+    const std::string where = file.string() + ":" + std::to_string(line_no) + ": ";
+    if (columns == 0) {
+      columns = line == "x,y,z,radius" ? 4 : line == "x,y,z,radius,vx,vy,vz" ? 7 : 0;
+      if (columns == 0)
+        throw InputError(where + "expected the header x,y,z,radius or x,y,z,radius,vx,vy,vz (dem.sample.table)");
+      continue;
+    }
+    double v[7];
+    const char* c = line.data();
+    const char* const stop = line.data() + line.size();
+    for (std::size_t k = 0; k < columns; ++k) {
+      const auto [next, error] = std::from_chars(c, stop, v[k]);
+      const bool last = k + 1 == columns;
+      if (error != std::errc() || (last ? next != stop : (next == stop || *next != ',')) || !std::isfinite(v[k]))
+        throw InputError(where + "expected " + std::to_string(columns) + " comma-separated numbers (dem.sample.table)");
+      c = next + 1;
+    }
+    if (!(v[3] > 0.0)) throw InputError(where + "a radius must be > 0 m (dem.sample.table)");
+    const Vec3 x{v[0], v[1], v[2]};
+    if (scene.continuum && !scene.continuum->in_dem_domain(x))
+      throw InputError(where + "this DE lies beyond the coupling overlap, in the pure-continuum zone (dem.sample.table)");
+    const std::size_t i = p.add(x, v[3], density);
+    if (columns == 7) p.velocity[i] = {v[4], v[5], v[6]};
+  }
+  if (columns == 0 || p.size() == 0) throw InputError(file.string() + ": no DE in the table (dem.sample.table)");
+}
+
 void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
   static constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packing"};
   dem::ParticleSet& p = scene.dem.particles;
@@ -196,7 +241,11 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     scene.des_not_created = p.keep_only([&](std::size_t i) { return scene.continuum->in_dem_domain(p.position[i]); });
   // Explicit DEs (an impactor, a two-body test), after the built ones; the only ones for
   // build: particles.
-  const auto listed = build == "particles" ? sample.list("particles") : sample.list_or_empty("particles");
+  // A large set of DEs comes as a table (a YAML list of 500 000 DEs takes the YAML parser
+  // minutes): read before the list, which may add more.
+  const bool table = build == "particles" && sample.has("table");
+  if (table) read_particle_table(sample, scene, density);
+  const auto listed = build == "particles" && !table ? sample.list("particles") : sample.list_or_empty("particles");
   for (CaseNode item : listed) {
     const Vec3 x = item.vec3("position", Range::any(), "m");
     if (scene.continuum && !scene.continuum->in_dem_domain(x))

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "app/scene.hpp"
 #include "support/cli.hpp"
 
 namespace arlequin {
@@ -197,6 +198,42 @@ TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
   }
   const auto r = test::run_arlequin("check " + bar + " --set continuum.mesh.file=" + (dir / "syntax.geo").string());
   EXPECT_NE(r.output.find("line 1"), std::string::npos) << r.output;
+}
+
+// A large set of DEs comes as a CSV table (a YAML list of 500 000 DEs took the YAML parser
+// minutes in check): it is read as written, and a bad row is an error at FILE:LINE.
+TEST(BadInput, ParticleTableIsReadAndItsBadRowsNamed) {
+  const auto dir = test::scratch_dir("particle_table");
+  const auto write_case = [&](const std::string& table) {
+    std::ofstream(dir / "des.csv") << table;
+    std::ofstream(dir / "case.yaml") << "name: table\ntime: {end: 1.0e-6, dt: 1.0e-8}\ndem:\n  density: 7800\n"
+                                        "  sample: {build: particles, table: des.csv}\n";
+    return test::run_arlequin("check " + (dir / "case.yaml").string(), "stdout");
+  };
+  const auto good = write_case("x,y,z,radius,vx,vy,vz\n0,0,0,0.001,1.5,0,0\n0.002,0,0,0.001,0,0,-2\n\n0.004,0,0,0.002,0,0,0\n");
+  ASSERT_EQ(good.exit_code, 0) << good.output;
+  EXPECT_NE(good.output.find("DEs: 3"), std::string::npos) << good.output;
+  const app::Scene scene = app::build_scene((dir / "case.yaml").string(), {.overrides = {}, .out_dir = dir / "out", .petsc_options = ""});
+  const dem::ParticleSet& p = scene.dem.particles;
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p.position[1].x, 0.002);
+  EXPECT_EQ(p.radius[2], 0.002);
+  EXPECT_EQ(p.velocity[0].x, 1.5);
+  EXPECT_EQ(p.velocity[1].z, -2.0);
+  struct Bad {
+    std::string table, expected;
+  };
+  for (const Bad& b : std::vector<Bad>{{"x,y,z,r\n0,0,0,1\n", "des.csv:1: expected the header x,y,z,radius"},
+                                       {"x,y,z,radius\n0,0,0,0.001\n0,0,zero,0.001\n", "des.csv:3: expected 4 comma-separated numbers"},
+                                       {"x,y,z,radius\n0,0,0,0.001,7\n", "des.csv:2: expected 4 comma-separated numbers"},
+                                       {"x,y,z,radius\n0,0,0,-0.001\n", "des.csv:2: a radius must be > 0 m"},
+                                       {"x,y,z,radius\n", "des.csv: no DE in the table"}}) {
+    const auto r = write_case(b.table);
+    EXPECT_EQ(r.exit_code, 2) << b.table;
+    const auto err = test::run_arlequin("check " + (dir / "case.yaml").string());
+    EXPECT_NE(err.output.find(b.expected), std::string::npos) << "missing '" << b.expected << "' in: " << err.output;
+    EXPECT_EQ(std::count(err.output.begin(), err.output.end(), '\n'), 1) << err.output;
+  }
 }
 
 // A mesh size far below the body's extent is refused before meshing (it ran for hours, silent).

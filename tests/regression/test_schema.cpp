@@ -96,6 +96,11 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
   read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
   read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
 
+  std::ofstream(dir_ / "des.csv") << "x,y,z,radius\n0,0,0,0.001\n0.002,0,0,0.001\n";
+  std::ofstream(dir_ / "table.yaml") << "time: {end: 1.0e-6, dt: 1.0e-8}\ndem:\n  density: 7800\n"
+                                        "  sample: {build: particles, table: des.csv}\n";
+  read_case((dir_ / "table.yaml").string(), {}, dir_);
+
   EXPECT_TRUE(unread_keys(app::case_schema()).empty()) << "declared but never read:" << unread_keys(app::case_schema());
 }
 
