@@ -27,9 +27,9 @@ using Clock = std::chrono::steady_clock;
 
 // The continuum's own terms of the energy balance when it steps alone (with a DEM beside it or
 // none): its tractions' and supports' work, and velocity Verlet's shadow correction at the run's
-// step, without which a continuum at 0.9 of its critical step showed a balance of 25-45 % of its
-// energy (docs/theory.md#energy). A coupled step keeps the balance it had (its supports hold
-// still, and the coupling's own invariant is tested apart).
+// step, which together close the balance of linear elasticity at any step (docs/theory.md#energy,
+// decisions.md#d30). A coupled step keeps the balance it had (its supports hold still, and the
+// coupling's own invariant is tested apart).
 std::pair<double, double> continuum_balance_terms(const Scene& scene) {
   if (!scene.continuum || scene.model->monitor() || scene.static_only()) return {0.0, 0.0};
   return {scene.continuum->external_work(), scene.continuum->verlet_correction(scene.dt)};

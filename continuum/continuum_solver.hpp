@@ -222,8 +222,9 @@ class ContinuumSolver {
   Field u_, v_, f_;
   double t_ = 0.0;
   double external_work_ = 0.0;
-  // step()'s scratch: u, f_ext and the prescribed dofs' f at the step's start, f_ext at its end.
-  Field step_u_, step_f_ext_, step_f_ext_new_, step_f_fixed_;
+  // step()'s scratch: with tractions, u and f_ext at the step's start and f_ext at its end; the
+  // prescribed dofs' u and f at the step's start.
+  Field step_u_, step_f_ext_, step_f_ext_new_, step_fixed_u_, step_f_fixed_;
 };
 
 }  // namespace arlequin::continuum
