@@ -183,11 +183,11 @@ void read_particle_table(CaseNode& sample, Scene& scene, double density) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty()) continue;
-    const std::string where = file.string() + ":" + std::to_string(line_no) + ": ";
+    const auto where = [&] { return file.string() + ":" + std::to_string(line_no) + ": "; };  // for errors only
     if (columns == 0) {
       columns = line == "x,y,z,radius" ? 4 : line == "x,y,z,radius,vx,vy,vz" ? 7 : 0;
       if (columns == 0)
-        throw InputError(where + "expected the header x,y,z,radius or x,y,z,radius,vx,vy,vz (dem.sample.table)");
+        throw InputError(where() + "expected the header x,y,z,radius or x,y,z,radius,vx,vy,vz (dem.sample.table)");
       continue;
     }
     double v[7];
@@ -197,13 +197,13 @@ void read_particle_table(CaseNode& sample, Scene& scene, double density) {
       const auto [next, error] = std::from_chars(c, stop, v[k]);
       const bool last = k + 1 == columns;
       if (error != std::errc() || (last ? next != stop : (next == stop || *next != ',')) || !std::isfinite(v[k]))
-        throw InputError(where + "expected " + std::to_string(columns) + " comma-separated numbers (dem.sample.table)");
+        throw InputError(where() + "expected " + std::to_string(columns) + " comma-separated numbers (dem.sample.table)");
       c = next + 1;
     }
-    if (!(v[3] > 0.0)) throw InputError(where + "a radius must be > 0 m (dem.sample.table)");
+    if (!(v[3] > 0.0)) throw InputError(where() + "a radius must be > 0 m (dem.sample.table)");
     const Vec3 x{v[0], v[1], v[2]};
     if (scene.continuum && !scene.continuum->in_dem_domain(x))
-      throw InputError(where + "this DE lies beyond the coupling overlap, in the pure-continuum zone (dem.sample.table)");
+      throw InputError(where() + "this DE lies beyond the coupling overlap, in the pure-continuum zone (dem.sample.table)");
     const std::size_t i = p.add(x, v[3], density);
     if (columns == 7) p.velocity[i] = {v[4], v[5], v[6]};
   }
