@@ -104,6 +104,16 @@ void DemModel::finalize() {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
+  if (contact_) {
+    // check_contact_resolution's critical step of the contacts a DE has now: its bonds' row
+    // of the bound (set-up values: a break only lowers it) plus its touching contacts'.
+    const std::size_t n = particles.size();
+    bond_frequency_bound_.assign(n, 0.0);
+    std::vector<double> rot(n, 0.0);
+    for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, bond_frequency_bound_, rot);
+    inv_mass_max_ = n > 0 ? *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end()) : 0.0;
+    touching_.assign(n, 0);
+  }
   if (rdef_) rdef_->prepare(particles);
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
@@ -112,18 +122,20 @@ void DemModel::finalize() {
   apply_loads_and_damping();
 }
 
+double DemModel::contact_frequency_bound(std::size_t i, std::uint32_t contacts) const {
+  const double inv_m = particles.inv_mass[i];
+  return contact_->stiffness() * contacts * (inv_m + std::sqrt(inv_m * inv_mass_max_));
+}
+
 double DemModel::critical_time_step() const {
   const std::size_t n = particles.size();
   std::vector<double> trans(n, 0.0), rot(n, 0.0);
   for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, trans, rot);
   if (contact_ && n > 0) {
-    std::vector<int> count(n, 0);
+    std::vector<std::uint32_t> count(n, 0);
     if (neighbours_)
       for (auto [i, j] : neighbours_->pairs()) ++count[i], ++count[j];
-    const double inv_m_max = *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end());
-    for (std::size_t i = 0; i < n; ++i)
-      trans[i] += contact_->stiffness() * std::max(1, count[i]) *
-                  (particles.inv_mass[i] + std::sqrt(particles.inv_mass[i] * inv_m_max));
+    for (std::size_t i = 0; i < n; ++i) trans[i] += contact_frequency_bound(i, std::max(1u, count[i]));
   }
   double omega2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) omega2 = std::max({omega2, trans[i], rot[i]});
@@ -252,7 +264,8 @@ double DemModel::compute_forces(const ForceScan& scan) {
   particles.clear_forces();
   for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
   if (!contact_) return 0.0;
-  deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles);
+  std::fill(touching_.begin(), touching_.end(), 0u);
+  deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles, touching_);
   return deepest_contact_.friction_power;
 }
 
@@ -289,6 +302,16 @@ void DemModel::apply_failures(bool record_energy) {
   if (neighbours_) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
+  }
+  if (contact_) {
+    // check_contact_resolution's critical step of the contacts a DE has now: its bonds' row
+    // of the bound (set-up values: a break only lowers it) plus its touching contacts'.
+    const std::size_t n = particles.size();
+    bond_frequency_bound_.assign(n, 0.0);
+    std::vector<double> rot(n, 0.0);
+    for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, bond_frequency_bound_, rot);
+    inv_mass_max_ = n > 0 ? *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end()) : 0.0;
+    touching_.assign(n, 0);
   }
   ForceScan scan;
   scan.energy = record_energy;
@@ -438,16 +461,19 @@ Vec3 DemModel::mean_velocity(int group) const {
 
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
-  std::size_t bad = 0, first = 0, fastest = 0;
-  double reach = 0.0;  // with contact: the largest distance a DE moved in the last step, over its radius
+  std::size_t bad = 0, first = 0;
+  ContactResolution worst;  // with contact
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
       if (bad++ == 0) first = i;
     }
-    if (contact_)
-      if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > reach) reach = r, fastest = i;
+    if (!contact_) continue;
+    if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
+    if (touching_[i] > 0)
+      if (const double row = bond_frequency_bound_[i] + contact_frequency_bound(i, touching_[i]); row > worst.omega2)
+        worst.omega2 = row, worst.crowded = i;
   }
-  if (bad == 0 && contact_) check_contact_resolution(fastest, reach);
+  if (bad == 0 && contact_) check_contact_resolution(worst);
   if (bad == 0) return;
   std::ostringstream msg;
   msg << "step " << steps_ << " (t = " << time_ << " s): " << bad << " DE(s) have a non-finite velocity, "
@@ -457,24 +483,41 @@ void DemModel::check_finite() const {
   throw RunError(msg.str());
 }
 
-void DemModel::check_contact_resolution(std::size_t fastest, double reach) const {
+void DemModel::check_contact_resolution(const ContactResolution& worst) const {
   // Moving more than its radius in a step, a DE can cross a contact without the contact ever
-  // seeing it; and the penalty holds an impact only if the overlap stays inside the spheres.
+  // seeing it; the penalty holds an impact only if the overlap stays inside the spheres; and a
+  // DE that touches more DEs than at set-up (an impact packing them together) raises the
+  // highest frequency above the one the step was set for (the bound of critical_time_step
+  // with its contacts now: stable while omega^2 dt^2 + 2 c dt < 4).
   const ContactPass& c = deepest_contact_;
-  if (reach <= 1.0 && c.deepest <= 1.0) return;
+  const double dt = last_dt_;
+  const bool crowded = worst.omega2 * dt * dt + 2.0 * damping_ * dt >= 4.0;
+  if (worst.reach <= 1.0 && c.deepest <= 1.0 && !crowded) return;
   const ParticleSet& p = particles;
+  const auto at = [&p](std::size_t i) {
+    std::ostringstream where;
+    where << "DE " << i << " at (" << p.position[i].x << ", " << p.position[i].y << ", " << p.position[i].z << ") m";
+    return where.str();
+  };
   std::ostringstream msg;
   msg << "step " << steps_ << " (t = " << time_ << " s): ";
-  if (reach > 1.0)
-    msg << "DE " << fastest << " at (" << p.position[fastest].x << ", " << p.position[fastest].y << ", "
-        << p.position[fastest].z << ") m moves " << reach << " of its radius per step (" << norm(p.velocity[fastest])
+  if (worst.reach > 1.0) {
+    const std::size_t i = worst.fastest;
+    msg << at(i) << " moves " << worst.reach << " of its radius per step (" << norm(p.velocity[i])
         << " m/s): a contact can be crossed unseen; lower the time step (time.safety or time.dt) below "
-        << p.radius[fastest] / norm(p.velocity[fastest]) << " s";
-  else
+        << p.radius[i] / norm(p.velocity[i]) << " s";
+  } else if (c.deepest > 1.0) {
     msg << "the contact of DEs " << c.first << " and " << c.second << " overlaps " << c.deepest
         << " of the smaller radius: the contact stiffness (" << contact_->stiffness()
         << " N/m) is too soft to stop this impact within the spheres (an impact of energy E needs about "
            "K >= 2 E / R^2); raise dem.contact.stiffness";
+  } else {
+    const double limit = 4.0 / (damping_ + std::sqrt(damping_ * damping_ + 4.0 * worst.omega2));
+    msg << at(worst.crowded) << " touches " << touching_[worst.crowded] << " DEs at once: with its bonds and "
+        << contact_->stiffness() << " N/m per contact its critical step is " << limit << " s, below the step " << dt
+        << " s set for the contacts at set-up (likely cause: an impact packing DEs together); lower the time step "
+           "(time.safety or time.dt) below " << limit << " s";
+  }
   throw RunError(msg.str());
 }
 

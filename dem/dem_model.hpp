@@ -76,6 +76,7 @@ class DemModel {
   // bonds and contacts, lowered by damping (docs/theory.md#critical-step). Contacts count as
   // many per DE as it has neighbours at setup (at least one), with the stiffness of the contact
   // law; with contact, no DE may move more than its radius in a step at its present speed.
+  // check_finite stops a run whose DEs come to touch more DEs than that allows.
   double critical_time_step() const;
 
   // One velocity-Verlet step of size dt (s): the phases, in order. step() is
@@ -130,8 +131,16 @@ class DemModel {
   void drift(double dt);
   void update_neighbours();
   double compute_forces(const ForceScan& scan = {});  // returns the friction's power, W
-  // check_finite's contact part, given the DE that moved furthest over its radius in the last step.
-  void check_contact_resolution(std::size_t fastest, double reach) const;
+  // check_finite's contact part, given what its pass over the DEs found.
+  struct ContactResolution {
+    double reach = 0.0;           // the largest distance a DE moved in the last step, over its radius
+    std::size_t fastest = 0;      // that DE
+    double omega2 = 0.0;          // the largest frequency bound (1/s^2) with the contacts touching now
+    std::size_t crowded = 0;      // that DE
+  };
+  void check_contact_resolution(const ContactResolution& worst) const;
+  // DE i's row of the frequency bound (1/s^2) from `contacts` contacts (critical_time_step).
+  double contact_frequency_bound(std::size_t i, std::uint32_t contacts) const;
   // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();
@@ -153,6 +162,9 @@ class DemModel {
   std::unique_ptr<ContactLaw> contact_;
   std::optional<NeighbourList> neighbours_;
   ContactPass deepest_contact_;  // of the last force pass
+  std::vector<std::uint32_t> touching_;        // per DE: its touching contacts in the last force pass
+  std::vector<double> bond_frequency_bound_;   // per DE: its bonds' translational row of the bound, 1/s^2
+  double inv_mass_max_ = 0.0;                  // 1/kg, of the lightest DE
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)

@@ -28,8 +28,10 @@ class ContactKernelLaw : public ContactLaw {
  public:
   std::string_view law() const override { return Law::name; }
 
-  ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p) const override {
+  ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p,
+                                std::span<std::uint32_t> touching = {}) const override {
     const double mu = self().friction();
+    const bool count = !touching.empty();
     ContactPass pass;
     for (auto [i, j] : list.pairs()) {
       const Vec3 d = p.position[j] - p.position[i];
@@ -40,6 +42,7 @@ class ContactKernelLaw : public ContactLaw {
       const Vec3 f_j = self().force_on_j(d, distance, reach);
       p.force[i] -= f_j;
       p.force[j] += f_j;
+      if (count) ++touching[i], ++touching[j];
       if (mu > 0.0) pass.friction_power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
       const double depth = (reach - distance) / std::min(p.radius[i], p.radius[j]);
       if (depth > pass.deepest) pass = {pass.friction_power, depth, i, j};

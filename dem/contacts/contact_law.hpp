@@ -4,7 +4,9 @@
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually
 // touching (|x_i - x_j| < R_i + R_j) and returns the power its friction dissipates at the
 // present velocities (W, >= 0; 0 for a frictionless law) and the deepest contact (its overlap
-// over the pair's smaller radius, and the pair); energy() is the elastic energy of
+// over the pair's smaller radius, and the pair), and adds one to touching[i] and touching[j]
+// for each touching pair (touching: one count per DE, zeroed by the caller; empty: not
+// counted); energy() is the elastic energy of
 // those contacts; stiffness() is the largest normal stiffness a contact can have (N/m), for the
 // critical time step. One virtual call per batch of pairs, none per pair.
 #pragma once
@@ -34,7 +36,8 @@ class ContactLaw {
  public:
   virtual ~ContactLaw() = default;
   virtual std::string_view law() const = 0;
-  virtual ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p) const = 0;
+  virtual ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p,
+                                         std::span<std::uint32_t> touching = {}) const = 0;
   virtual double energy(const NeighbourList& list, const ParticleSet& p) const = 0;
   virtual double stiffness() const = 0;
 };
