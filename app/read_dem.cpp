@@ -118,6 +118,18 @@ constexpr SchemaSection dem_sections[] = {
     {"dem.failure.rdef.material_thresholds", "RDEF threshold per material", material_threshold_keys},
 };
 
+// A lattice, chain or packing of `des` DEs that cannot fit in this machine's memory is refused at `key`
+// before it is built: a DE's state takes about 200 B (dem/particles.hpp, structure of arrays)
+// and a lattice DE's three bonds at least 100 B each, so 500 B per DE is a floor.
+void refuse_beyond_memory(CaseNode& sample, const char* key, double des) {
+  constexpr double kBytesPerDe = 500.0;
+  if (const std::string beyond = beyond_memory(des * kBytesPerDe, "about 500 B per DE with its bonds"); !beyond.empty()) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.3g", des);
+    sample.fail(key, std::string("makes ") + count + " DEs, " + beyond);
+  }
+}
+
 // A dense random packing (dem/packing.hpp), cached in an HDF5 sample file: built once, then
 // loaded while the file's spec matches the case's.
 void read_packing(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
@@ -134,6 +146,11 @@ void read_packing(CaseNode sample, Scene& scene, double density, const SceneOpti
   spec.min_coordination = sample.number_or("min_coordination", 6.0, Range::non_negative(), "1");
   spec.seed = static_cast<std::uint64_t>(sample.integer_or("seed", 1, Range::at_least(0)));
   spec.bond_tolerance = sample.number_or("bond_tolerance", 0.03, Range::between(0.0, 0.5), "1");
+  try {
+    refuse_beyond_memory(sample, "region", dem::estimated_count(spec));
+  } catch (const std::invalid_argument& e) {
+    sample.fail("region", e.what());
+  }
   std::filesystem::path file = sample.string_or("file", "results/" + scene.name + "/sample.h5");
   if (file.is_relative()) file = scene.case_file.parent_path() / file;
   scene.sample_file = file;
@@ -157,17 +174,6 @@ void read_packing(CaseNode sample, Scene& scene, double density, const SceneOpti
   if (options.write_sample_cache) dem::save_sample(file, p, spec, scene.sample->report);
 }
 
-// A lattice or chain of `des` DEs that cannot fit in this machine's memory is refused at `key`
-// before it is built: a DE's state takes about 200 B (dem/particles.hpp, structure of arrays)
-// and a lattice DE's three bonds at least 100 B each, so 500 B per DE is a floor.
-void refuse_beyond_memory(CaseNode& sample, const char* key, double des) {
-  constexpr double kBytesPerDe = 500.0;
-  if (const std::string beyond = beyond_memory(des * kBytesPerDe, "about 500 B per DE with its bonds"); !beyond.empty()) {
-    char count[32];
-    std::snprintf(count, sizeof count, "%.3g", des);
-    sample.fail(key, std::string("makes ") + count + " DEs, " + beyond);
-  }
-}
 
 // build: particles, table: FILE.csv. Header x,y,z,radius with optional vx,vy,vz (in that
 // order); each further line one DE. InputError at FILE:LINE for a row that is not those numbers.

@@ -617,7 +617,11 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   r.modulus_used = setup.modulus;
   r.transit_time = setup.transit;
   r.damping = setup.damping;
-  const auto [scene, run] = setup.run(case_file, test_overrides(g, load, plan, r.transit_time, r.damping));
+  // Named references, not a structured binding: the lambdas below use the scene, and clang 14
+  // (the fuzz build's) cannot capture structured bindings.
+  const auto scene_and_run = setup.run(case_file, test_overrides(g, load, plan, r.transit_time, r.damping));
+  const Scene& scene = scene_and_run.first;
+  const RunResult& run = scene_and_run.second;
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.particles = scene.dem.particles.size();
   r.bonds = bond_count(scene.dem);

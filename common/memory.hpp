@@ -22,9 +22,19 @@ inline std::string gigabytes(double bytes) {
   return text;
 }
 
-// Empty if `bytes` fits in the physical memory (or it is unknown); else the sentence to add to
-// an error: "which needs at least X (WHY); this machine has Y".
+// A budget below the machine's memory, bytes (0: none). The fuzz targets set one, so that an
+// input asking for gigabytes is refused as it would be on a small machine, not built.
+inline double& memory_budget_bytes() {
+  static double budget = 0.0;
+  return budget;
+}
+
+// Empty if `bytes` fits in the physical memory (or it is unknown) and the budget; else the
+// sentence to add to an error: "which needs at least X (WHY); this machine has Y".
 inline std::string beyond_memory(double bytes, const std::string& why) {
+  const double budget = memory_budget_bytes();
+  if (budget > 0.0 && bytes > budget)
+    return "which needs at least " + gigabytes(bytes) + " (" + why + "); the memory budget is " + gigabytes(budget);
   const double have = physical_memory_bytes();
   if (have <= 0.0 || bytes <= have) return {};
   return "which needs at least " + gigabytes(bytes) + " (" + why + "); this machine has " + gigabytes(have);

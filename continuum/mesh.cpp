@@ -6,8 +6,16 @@
 #include <omp.h>
 #endif
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -47,6 +55,43 @@ struct GmshScope {
   int threads = omp_get_max_threads();  // initialised before the constructor's body runs
 #endif
 };
+
+// gmsh's .msh reader trusts its input: a malformed file can make it write out of bounds or free
+// twice and bring the program down (found by fuzz/fuzz_mesh.cpp). So a .msh is first read by
+// the gmsh program in a process of its own (`gmsh FILE -0`, the same reader); if that process
+// dies of a signal, the file is refused with one line instead of read here. Where the gmsh
+// program cannot be started, the file is read here unchecked.
+void refuse_if_gmsh_crashes_on(const std::string& path) {
+  posix_spawn_file_actions_t quiet;
+  posix_spawn_file_actions_init(&quiet);
+  posix_spawn_file_actions_addopen(&quiet, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&quiet, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&quiet, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  // The child starts with default signal handling and none blocked (the program's handlers of
+  // SIGINT and SIGTERM are not its).
+  posix_spawnattr_t attr;
+  posix_spawnattr_init(&attr);
+  sigset_t all;
+  sigfillset(&all);
+  posix_spawnattr_setsigdefault(&attr, &all);
+  sigset_t none;
+  sigemptyset(&none);
+  posix_spawnattr_setsigmask(&attr, &none);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
+  std::string program = "gmsh", file = path, model_only = "-0", out = "-o", sink = "/dev/null", format = "-format", msh = "msh41";
+  char* argv[] = {program.data(), file.data(), model_only.data(), out.data(), sink.data(), format.data(), msh.data(), nullptr};
+  pid_t child = 0;
+  const int spawned = posix_spawnp(&child, "gmsh", &quiet, &attr, argv, environ);
+  posix_spawn_file_actions_destroy(&quiet);
+  posix_spawnattr_destroy(&attr);
+  if (spawned != 0) return;
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    throw InputError("mesh file " + path + ": gmsh crashes reading it (" + strsignal(WTERMSIG(status)) +
+                     "): a malformed or truncated .msh; write it again from gmsh");
+}
 
 // MeshSource::left_out on the raw arrays; returns the number of tetrahedra dropped.
 int leave_out(int npe, const std::function<bool(const Vec3&)>& left_out, std::vector<Vec3>& nodes,
@@ -99,6 +144,7 @@ Mesh Mesh::load(const MeshSource& source) {
   if (ext != ".geo" && ext != ".msh") throw InputError("mesh file must be .geo or .msh: " + source.path);
   if (source.order != 1 && source.order != 2) throw InputError("mesh order must be 1 or 2, got " + std::to_string(source.order));
 
+  if (ext == ".msh") refuse_if_gmsh_crashes_on(source.path);
   std::lock_guard<std::mutex> lock(g_gmsh_mutex);
   GmshScope scope;
   try {

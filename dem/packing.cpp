@@ -560,6 +560,12 @@ double implied_wall_deficit(const Domain& domain, const Packing& packing, double
 
 }  // namespace
 
+double estimated_count(const PackingSpec& spec) {
+  check(spec);
+  const double s = spec.relative_std;
+  return spec.target_compaction * Domain(spec.region).volume(0.0) / (sphere_volume(spec.mean_radius) * (1.0 + 3.0 * s * s));
+}
+
 PackingReport build_packing(ParticleSet& p, const PackingSpec& spec, double density) {
   const auto start = std::chrono::steady_clock::now();
   check(spec);

@@ -64,4 +64,10 @@ inline constexpr double interior_margin = 2.0;
 
 PackingReport build_packing(ParticleSet& p, const PackingSpec& spec, double density);
 
+// About how many DEs build_packing makes for the spec: the region's volume times the target
+// compaction over the mean sphere volume, 4/3 pi R^3 (1 + 3 std^2) (the truncation ignored).
+// For refusing a packing beyond the memory before it is built; throws as build_packing does
+// for a bad spec or an unbounded region.
+double estimated_count(const PackingSpec& spec);
+
 }  // namespace arlequin::dem

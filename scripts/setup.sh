@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Shared by run.sh and test.sh: install the Debian packages if any is missing (needs root:
-# apt-get install), then configure and build into build/.
+# apt-get install), then configure and build into build/. With --fuzz (test.sh): also clang
+# and libFuzzer, and the fuzz targets (fuzz/, ASan + UBSan) built with them into build-fuzz/.
 # The list is everything a bare Debian 12 lacks for the build and the tests: the compiler and a
 # build program (make, which CMake's default generator drives), the libraries, gmsh for the
 # meshes, openmpi-bin for mpirun (ContinuumMpi.MatchesSerial runs the static solve on 2 ranks),
@@ -11,6 +12,11 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 packages=(g++ make cmake pkg-config libeigen3-dev petsc-dev openmpi-bin libcgal-dev
           libgmsh-dev gmsh libhdf5-dev libgtest-dev libyaml-cpp-dev nlohmann-json3-dev
           python3 python3-matplotlib python3-numpy python3-pandas python3-h5py python3-pytest)
+fuzz=false
+if [[ ${1:-} == --fuzz ]]; then
+  fuzz=true
+  packages+=(clang-14 libfuzzer-14-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
@@ -35,3 +41,9 @@ fi
 jobs=$(nproc)
 cmake -S "$root" -B "$root/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$root/build" -j "$jobs"
+if $fuzz; then
+  # The fuzz build needs no OpenMP (one thread per input), tests or benchmarks.
+  CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=Release -DARLEQUIN_FUZZ=ON \
+    -DARLEQUIN_WITH_OPENMP=OFF -DARLEQUIN_BUILD_TESTS=OFF -DARLEQUIN_BUILD_BENCH=OFF >/dev/null
+  cmake --build "$root/build-fuzz" -j "$jobs"
+fi
