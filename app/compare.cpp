@@ -27,6 +27,7 @@ struct Run {
   std::size_t particles = 0;
   long nodes = 0, steps = 0;
   bool ok = true;
+  bool checks_passed = true;  // the case's own checks (those evaluated)
 
   double compute_seconds() const { return loop - output; }
   std::vector<double> column(const std::string& name_) const {
@@ -65,7 +66,7 @@ Run execute(Prepared& prepared, const std::filesystem::path& out) {
   scene.model->describe(counts);
   run.nodes = counts.value("continuum_nodes", 0L);
   try {
-    run_scene(scene, run_options);
+    run.checks_passed = run_scene(scene, run_options).all_checks_passed();
   } catch (const RunError&) {
     run.ok = false;
   }
@@ -115,12 +116,13 @@ Json describe_run(const Run& r) {
   j["compute_seconds"] = r.compute_seconds();
   j["output_seconds"] = r.output;
   j["completed"] = r.ok;
+  j["checks_passed"] = r.checks_passed;
   return j;
 }
 
 }  // namespace
 
-bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
+CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                  const SceneOptions& base, const std::filesystem::path& out_dir) {
   std::error_code ec;
   if (std::filesystem::equivalent(reference_case, other_case, ec))
@@ -182,6 +184,8 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", b.name.c_str(),
               b.particles, b.nodes, b.steps, b.compute_seconds(), b.setup, b.output);
   std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
+  for (const Run* r : {&a, &b})
+    if (!r->checks_passed) std::printf("%s: a check of its case FAILED (its summary.json says which)\n", r->name.c_str());
 
   Json report = Json::object();
   report["reference"] = describe_run(a);
@@ -191,7 +195,7 @@ bool run_compare(const std::filesystem::path& reference_case, const std::filesys
   write_file_atomically(out_dir / "compare.csv", csv);
   write_json_atomically(out_dir / "compare.json", report);
   write_plots(out_dir, plots);
-  return a.ok && b.ok;
+  return {a.ok && b.ok, a.checks_passed && b.checks_passed};
 }
 
 }  // namespace arlequin::app

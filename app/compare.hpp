@@ -14,9 +14,15 @@
 
 namespace arlequin::app {
 
-// Builds both scenes, then runs them one after the other. Returns false if a run failed.
+// What the two runs came to: both completed, and both passed their case's checks.
+struct CompareOutcome {
+  bool completed = true;
+  bool checks_passed = true;
+};
+
+// Builds both scenes, then runs them one after the other, each judged by its own checks.
 // InputError, before any run, when a case is bad or the cases share no sensor column.
-bool run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
+CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                  const SceneOptions& base, const std::filesystem::path& out_dir);
 
 }  // namespace arlequin::app

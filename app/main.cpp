@@ -76,7 +76,7 @@ constexpr const char* usage_compare =
     "  run), runs them (results in DIR/reference and DIR/other, default results/compare), then for\n"
     "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
     "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
-    "  compare_<sensor>.png\n";
+    "  compare_<sensor>.png. Each run is judged by its own case's checks: exit 5 if one fails\n";
 
 constexpr const char* usage_virtual_test =
     "usage: arlequin virtual-test SPEC.yaml [--out DIR] [--sample NAME ...] [--set k=v ...]\n"
@@ -301,10 +301,11 @@ int compare(const Arguments& a) {
   if (out.empty()) out = "results/compare";
   app::SceneOptions base = a.scene;
   base.out_dir.clear();
-  const bool ok = app::run_compare(a.case_file, a.second_case, base, out);
+  const app::CompareOutcome outcome = app::run_compare(a.case_file, a.second_case, base, out);
   std::printf("comparison: %s (compare.csv, compare.json, compare_<sensor>.png)\n",
               std::filesystem::absolute(out).string().c_str());
-  return ok ? 0 : 3;
+  if (!outcome.completed) return 3;
+  return outcome.checks_passed ? 0 : 5;
 }
 
 // Default results folder of a spec-driven command: results/<spec folder>_<spec name>.

@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <thread>
 #include <type_traits>
@@ -69,14 +71,19 @@ double energy_balance(const Json& summary) {
          e.at("external_work").get<double>();
 }
 
-// R1 chain through the case file: tip deflection P L^3 / (3 E I) = 5.432489e-6 m (1e-4).
+// R1 chain through the case file: tip deflection P L^3 / (3 E I), the case's own checks (the
+// run exits 0 only if they pass), and the energy balance. Bounds about 2x what the damped
+// relaxation leaves at t = 0.25 s.
 TEST(Cases, CantileverChainMatchesBeamTheory) {
   const Json s = run_case("cantilever_chain");
   EXPECT_EQ(s.at("status").get<std::string>(), "completed");
-  EXPECT_NEAR(s.at("sensors").at("tip_deflection").get<double>(), 5.432489e-6, 5.432489e-10);
-  EXPECT_NEAR(s.at("sensors").at("clamp_reaction").get<double>(), -0.01, 1e-8);
+  const double inertia = std::numbers::pi * std::pow(0.5e-3, 4) / 4.0, deflection = 0.01 * std::pow(0.02, 3) / (3.0 * 1e11 * inertia);
+  EXPECT_NEAR(s.at("sensors").at("tip_deflection").get<double>(), deflection, 1.5e-7 * deflection);
+  EXPECT_NEAR(s.at("sensors").at("clamp_reaction").get<double>(), -0.01, 1e-11);
+  ASSERT_EQ(s.at("checks").size(), 2u);
+  for (const auto& check : s.at("checks")) EXPECT_TRUE(check.at("passed").get<bool>()) << check.dump();
   // Static equilibrium: half the load's work is stored, half was damped out.
-  EXPECT_NEAR(energy_balance(s), 0.0, 1e-4 * s.at("energies").at("external_work").get<double>());
+  EXPECT_NEAR(energy_balance(s), 0.0, 8e-7 * s.at("energies").at("external_work").get<double>());
 }
 
 TEST(Cases, DemoBeamImpactConservesEnergyAndWritesFields) {
@@ -84,8 +91,10 @@ TEST(Cases, DemoBeamImpactConservesEnergyAndWritesFields) {
   const auto r = test::run_arlequin("run " + cases + "demo_beam_impact/case.yaml --quiet --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json s = read_json_file(out / "summary.json");
-  const double initial = 0.5 * 8.82e-4 * 400.0;  // ball: m = 7800 * 4/3 pi (3 mm)^3, v = 20 m/s
-  EXPECT_NEAR(s.at("energies").at("total").get<double>(), initial, 2e-3 * initial);
+  // The ball's kinetic energy, m = 7800 * 4/3 pi (3 mm)^3, v = 20 m/s, kept by velocity Verlet
+  // (bound about 1.5x its oscillation about the shadow energy at the end).
+  const double initial = 0.5 * 7800.0 * 4.0 / 3.0 * std::numbers::pi * std::pow(3e-3, 3) * 400.0;
+  EXPECT_NEAR(s.at("energies").at("total").get<double>(), initial, 7e-5 * initial);
   EXPECT_TRUE(std::filesystem::exists(out / "fields.h5"));
   EXPECT_TRUE(std::filesystem::exists(out / "fields.xdmf"));
   EXPECT_TRUE(no_temporary_files(out));
@@ -694,28 +703,40 @@ TEST(Cases, PulseDisplacementIsTheIntegralOfItsVelocity) {
   }
 }
 
-TEST(Cli, CompareReportsErrorAndSpeedUp) {
+// The user's error-against-run-time view on the README's window (cases/wave_bar_coupled/README.md:
+// 4 ms, the pulse's passage and its return from the far end): the coupled bar's probe against
+// the all-DEM bar, bounded at about 1.3x what it achieves (the speed-up is a benchmark's,
+// bench_coupled_step). Each run is judged by its own case's checks: compare exits 5 when one
+// fails (it exited 0 whatever they said).
+TEST(Cli, CompareBoundsTheCoupledErrorAndHonoursChecks) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("compare");
-  const auto r = test::run_arlequin("compare " + cases + "wave_bar_dem/case.yaml " + cases + "wave_bar_coupled/case.yaml --out " +
-                                        out.string(), "stdout");
+  const std::string pair = "compare " + cases + "wave_bar_dem/case.yaml " + cases + "wave_bar_coupled/case.yaml";
+  const auto r = test::run_arlequin(pair + " --set time.end=4e-3 --set output.fields=[] --set checks=[] --out " + out.string(), "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json c = read_json_file(out / "compare.json");
   EXPECT_EQ(c.at("reference").at("particles").get<std::int64_t>(), 2975);
   EXPECT_EQ(c.at("other").at("particles").get<std::int64_t>(), 775);
-  EXPECT_GT(c.at("speedup_compute").get<double>(), 0.0);  // the figure itself is a benchmark, not a test
   const auto& sensors = c.at("sensors");
   ASSERT_EQ(sensors.size(), 2u);
   EXPECT_EQ(sensors[0].at("sensor").get<std::string>(), "E_dem_side");
-  EXPECT_LT(sensors[1].at("rms_relative_difference").get<double>(), 0.2);  // u_probe
+  EXPECT_EQ(sensors[1].at("sensor").get<std::string>(), "u_probe");
+  EXPECT_LT(sensors[1].at("rms_relative_difference").get<double>(), 8.5e-3);
+  EXPECT_LT(sensors[1].at("max_relative_difference").get<double>(), 1.6e-2);
   EXPECT_TRUE(std::filesystem::exists(out / "compare_u_probe.png"));
   const Json plots = read_json_file(out / "plots.json").at("plots");  // each sensor's plot, in its unit
   ASSERT_EQ(plots.size(), 2u);
   EXPECT_EQ(plots.at(0).at("y_label").get<std::string>(), "E_dem_side [J]");
   EXPECT_EQ(plots.at(1).at("y_label").get<std::string>(), "u_probe [m]");
   EXPECT_TRUE(std::filesystem::exists(out / "compare.csv"));
+
+  const auto failed = test::run_arlequin(pair + " --set output.fields=[] --set \"checks=[{column: E_dem_side, statistic: "
+                                                "final_over_initial, at_most: 1.0e-9}]\" --out " + (out / "failing").string(), "stdout");
+  EXPECT_EQ(failed.exit_code, 5) << failed.output;
+  EXPECT_NE(failed.output.find("wave_bar_coupled: a check of its case FAILED"), std::string::npos) << failed.output;
+  EXPECT_FALSE(read_json_file(out / "failing" / "compare.json").at("other").at("checks_passed").get<bool>());
 }
 
 // case.resolved.yaml (also what `arlequin check` prints) is a case file: read back, it resolves
