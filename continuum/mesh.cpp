@@ -58,7 +58,7 @@ struct GmshScope {
 
 // gmsh's .msh reader trusts its input: a malformed file can make it write out of bounds or free
 // twice and bring the program down (found by fuzz/fuzz_mesh.cpp). So a .msh is first read by
-// the gmsh program in a process of its own (`gmsh FILE -0`, the same reader); if that process
+// the gmsh program in a process of its own (`gmsh FILE -0 -o /dev/null`, the same reader); if that process
 // dies of a signal, the file is refused with one line instead of read here. Where the gmsh
 // program cannot be started, the file is read here unchecked.
 void refuse_if_gmsh_crashes_on(const std::string& path) {

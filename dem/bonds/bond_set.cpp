@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <bit>
 #include <numeric>
-#include <stdexcept>
 
 namespace arlequin::dem {
 
@@ -12,16 +11,26 @@ std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> f
                                                 std::span<const std::uint32_t> second,
                                                 std::size_t n_particles) {
   const std::size_t n = first.size();
-  std::vector<std::uint64_t> used(n_particles, 0);  // colours already taken at each DE
-  std::vector<std::uint8_t> colour(n);
-  int n_colours = 0;
+  // Greedy edge colouring: a bond takes the lowest colour free at both its DEs, so at most
+  // 2 max_degree - 1 colours; each DE keeps a bitset of its taken colours in `words` 64-bit
+  // words (one for any usual packing; a DE bonded to hundreds, a large DE among small ones,
+  // takes more).
+  std::vector<std::uint32_t> degree(n_particles, 0);
+  for (std::size_t b = 0; b < n; ++b) ++degree[first[b]], ++degree[second[b]];
+  const std::uint32_t max_degree = n_particles > 0 ? *std::max_element(degree.begin(), degree.end()) : 0;
+  const std::size_t words = (2 * std::size_t(max_degree) + 63) / 64;
+  std::vector<std::uint64_t> used(n_particles * words, 0);  // colours already taken at each DE
+  std::vector<std::uint32_t> colour(n);
+  std::uint32_t n_colours = 0;
   for (std::size_t b = 0; b < n; ++b) {
-    const std::uint64_t taken = used[first[b]] | used[second[b]];
-    if (taken == ~std::uint64_t{0}) throw std::length_error("bond colouring: more than 64 colours");
-    const int c = std::countr_one(taken);
-    colour[b] = static_cast<std::uint8_t>(c);
-    used[first[b]] |= std::uint64_t{1} << c;
-    used[second[b]] |= std::uint64_t{1} << c;
+    std::uint64_t* at_first = &used[first[b] * words];
+    std::uint64_t* at_second = &used[second[b] * words];
+    std::size_t w = 0;
+    while ((at_first[w] | at_second[w]) == ~std::uint64_t{0}) ++w;  // a free colour exists within `words`
+    const std::uint32_t c = std::uint32_t(64 * w) + std::uint32_t(std::countr_one(at_first[w] | at_second[w]));
+    colour[b] = c;
+    at_first[w] |= std::uint64_t{1} << (c % 64);
+    at_second[w] |= std::uint64_t{1} << (c % 64);
     n_colours = std::max(n_colours, c + 1);
   }
   std::vector<std::uint32_t> order(n);

@@ -38,8 +38,8 @@ struct BondColouring {
   bool threaded = false;
 
   // Greedy edge colouring of (first, second) in a scene of n_particles DEs; returns the
-  // permutation that sorts bonds by (colour, first), fills offsets and sets threaded. Throws
-  // std::length_error beyond 64 colours.
+  // permutation that sorts bonds by (colour, first), fills offsets and sets threaded. At most
+  // 2 d - 1 colours, d the largest number of bonds at one DE.
   std::vector<std::uint32_t> build(std::span<const std::uint32_t> first,
                                    std::span<const std::uint32_t> second, std::size_t n_particles);
 };

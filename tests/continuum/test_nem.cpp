@@ -130,7 +130,8 @@ TEST(ContinuumNem, LumpedMassAndStableExplicitSteps) {
     s->step(dt);
     emax = std::max(emax, s->kinetic_energy() + s->strain_energy());
   }
-  EXPECT_LT(emax / e0, 20.0);
+  std::printf("nem (stabilised, sibson): max E / E_0 %.4g at 0.9 dt_c\n", emax / e0);
+  EXPECT_LT(emax / e0, 1.15);  // 1 + 1.5x the measured excess
 }
 
 // L2 rate on the harmonic field (convergence_util.hpp). Plain SCNI stagnated here (rate 0.9,

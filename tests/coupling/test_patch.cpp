@@ -144,29 +144,36 @@ INSTANTIATE_TEST_SUITE_P(Coupling, CoupledPatch,
 // residual of a uniform strain is O(eps E A a / overlap) at the overlap nodes. Natural
 // neighbours integrate at the nodes (the weight at a node holds for its whole Voronoi cell), so
 // even constant weights leave a residual at the overlap edges. Gate: a regression guard on the
-// measured level (about 1-7 % of eps L here, see the printed lines).
-class CoupledGhostForce : public ::testing::TestWithParam<PatchCase> {};
-TEST_P(CoupledGhostForce, LevelIsBounded) { EXPECT_LT(patch_error(GetParam()), 0.1) << name(GetParam()); }
+// measured level (see the printed lines), each case's bound 1.5x its own.
+struct GhostCase {
+  PatchCase patch;
+  double bound;  // max |u - eps x| / (eps L)
+};
+class CoupledGhostForce : public ::testing::TestWithParam<GhostCase> {};
+TEST_P(CoupledGhostForce, LevelIsBounded) {
+  EXPECT_LT(patch_error(GetParam().patch), GetParam().bound) << name(GetParam().patch);
+}
 INSTANTIATE_TEST_SUITE_P(Coupling, CoupledGhostForce,
-                         ::testing::Values(PatchCase{"fe", Mediator::coarse, CouplingType::l2, WeightShape::linear, 1.0, 12.0},
-                                           PatchCase{"fe", Mediator::coarse, CouplingType::l2, WeightShape::linear, 2.0, 12.0},
-                                           PatchCase{"fe", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 1.0, 12.0},
-                                           PatchCase{"fe", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 2.0, 12.0},
-                                           PatchCase{"fe", Mediator::fine, CouplingType::l2, WeightShape::linear, 1.0, 12.0},
-                                           PatchCase{"fe", Mediator::fine, CouplingType::l2, WeightShape::linear, 2.0, 12.0},
-                                           PatchCase{"fe", Mediator::fine, CouplingType::l2, WeightShape::cubic, 1.0, 12.0},
-                                           PatchCase{"fe", Mediator::fine, CouplingType::l2, WeightShape::cubic, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::constant, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::constant, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::linear, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::linear, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::constant, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::constant, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::linear, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::linear, 2.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::cubic, 1.0, 12.0},
-                                           PatchCase{"nem", Mediator::fine, CouplingType::l2, WeightShape::cubic, 2.0, 12.0},
-                                           PatchCase{"fe", Mediator::coarse, CouplingType::l2, WeightShape::constant, 2.0, 12.0}),
-                         [](const ::testing::TestParamInfo<PatchCase>& param_info) { return name(param_info.param); });
+                         ::testing::Values(
+        GhostCase{{"fe", Mediator::coarse, CouplingType::l2, WeightShape::linear, 1.0, 12.0}, 3.14e-02},
+        GhostCase{{"fe", Mediator::coarse, CouplingType::l2, WeightShape::linear, 2.0, 12.0}, 2.29e-02},
+        GhostCase{{"fe", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 1.0, 12.0}, 3.65e-02},
+        GhostCase{{"fe", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 2.0, 12.0}, 3.66e-02},
+        GhostCase{{"fe", Mediator::fine, CouplingType::l2, WeightShape::linear, 1.0, 12.0}, 3.14e-02},
+        GhostCase{{"fe", Mediator::fine, CouplingType::l2, WeightShape::linear, 2.0, 12.0}, 2.55e-02},
+        GhostCase{{"fe", Mediator::fine, CouplingType::l2, WeightShape::cubic, 1.0, 12.0}, 3.65e-02},
+        GhostCase{{"fe", Mediator::fine, CouplingType::l2, WeightShape::cubic, 2.0, 12.0}, 3.33e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::constant, 1.0, 12.0}, 2.41e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::constant, 2.0, 12.0}, 3.61e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::linear, 1.0, 12.0}, 3.03e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::linear, 2.0, 12.0}, 2.21e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 1.0, 12.0}, 2.59e-02},
+        GhostCase{{"nem", Mediator::coarse, CouplingType::l2, WeightShape::cubic, 2.0, 12.0}, 2.93e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::constant, 1.0, 12.0}, 2.41e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::constant, 2.0, 12.0}, 1.71e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::linear, 1.0, 12.0}, 3.03e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::linear, 2.0, 12.0}, 1.39e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::cubic, 1.0, 12.0}, 2.59e-02},
+        GhostCase{{"nem", Mediator::fine, CouplingType::l2, WeightShape::cubic, 2.0, 12.0}, 2.15e-02},
+        GhostCase{{"fe", Mediator::coarse, CouplingType::l2, WeightShape::constant, 2.0, 12.0}, 1.74e-02}),
+                         [](const ::testing::TestParamInfo<GhostCase>& param_info) { return name(param_info.param.patch); });

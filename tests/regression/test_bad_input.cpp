@@ -207,7 +207,10 @@ TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
 // data/fuzz_found/<reader>/: `check` now refuses it in one line naming the file, or accepts it.
 // mesh/: .msh files gmsh's reader crashed on (gmsh_double_free.msh: a mutated MSH 4.1 whose
 // entities made it free a block twice); they are refused after gmsh, in a process of its own,
-// crashes on them (continuum/mesh.cpp).
+// crashes on them (continuum/mesh.cpp). particle_table/: tables of fuzz/fuzz_particle_table.cpp's
+// case (large_de_bonded_to_all.csv: DEs of 10 m among DEs of 1 mm, bonded to all of them, ended
+// in "internal error: bond colouring: more than 64 colours"; now coloured, then refused for its
+// coincident DEs).
 TEST(BadInput, EveryInputTheFuzzersCrashedOnIsRefusedInOneLine) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -223,7 +226,20 @@ TEST(BadInput, EveryInputTheFuzzersCrashedOnIsRefusedInOneLine) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     EXPECT_NE(r.output.find(path + ": gmsh crashes reading it"), std::string::npos) << r.output;
   }
-  EXPECT_GE(inputs, 1);
+  const auto dir = test::scratch_dir("fuzz_found_tables");
+  std::ofstream(dir / "case.yaml") << "name: fuzz_table\ntime: {end: 1.0e-6}\ndem:\n  density: 7800\n"
+                                      "  sample: {build: particles, table: table.csv}\n"
+                                      "  bond: {law: beam, E_mu: 2.0e11, r_mu: 0.5}\n"
+                                      "  contact: {law: penalty, stiffness: 1.0e7}\n";
+  for (const auto& entry : std::filesystem::directory_iterator(found / "particle_table")) {
+    ++inputs;
+    std::filesystem::copy_file(entry.path(), dir / "table.csv", std::filesystem::copy_options::overwrite_existing);
+    const auto r = test::run_arlequin("check " + (dir / "case.yaml").string());
+    EXPECT_EQ(r.exit_code, 2) << entry.path() << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+  }
+  EXPECT_GE(inputs, 2);
 }
 
 // A large set of DEs comes as a CSV table (a YAML list of 500 000 DEs took the YAML parser

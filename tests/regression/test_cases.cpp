@@ -187,7 +187,8 @@ TEST(Cases, BondedBlockShortRunBalancesEnergyWithoutContactSearch) {
   EXPECT_FALSE(s.at("counts").contains("contact_candidates"));  // bonded-only: no contact search
   const double work = s.at("energies").at("external_work").get<double>();
   EXPECT_GT(work, 0.0);
-  EXPECT_NEAR(energy_balance(s), 0.0, 1e-3 * work);
+  // Velocity Verlet's oscillation about its shadow energy while the pull starts (bound 1.5x).
+  EXPECT_NEAR(energy_balance(s), 0.0, 3e-4 * work);
 }
 
 // Continuum cases: the run's own checks (closed forms) decide the exit code.
@@ -482,7 +483,7 @@ TEST(Cases, LongRunAnnouncesItsRunTime) {
 // E_mu = 1 Pa, ran 750 times past its time.end), and the closing line's steps/s is the summary's.
 TEST(Cases, RunShorterThanAStepEndsAtTimeEnd) {
   const auto out = test::scratch_dir("shorter_than_a_step");
-  const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --set time.end=1e-12 --out " + out.string(), "stdout");
+  const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --set time.end=1e-12 --set checks=[] --out " + out.string(), "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json s = read_json_file(out / "summary.json");
   EXPECT_EQ(s.at("steps").get<long>(), 1);
@@ -617,26 +618,31 @@ TEST(Cases, WaveBarCoupledTransmitsThePulse) {
   // Default (h = 4a, lambda = 1.6 lambda_c): the case's own check, R <= 0.5 %.
   const Json coarse = run_case("wave_bar_coupled");
   EXPECT_TRUE(coarse.at("checks").at(0).at("passed").get<bool>());
-  // The coupling's monitor at every row (series.csv): the largest velocity mismatch between a
-  // coupled DE and the continuum at its centre, and the velocity constraint, which holds to
-  // round-off. On this mesh (h = 4a) the coarse mediator leaves the three DE planes between
-  // node planes free, and the mismatch is of the order of P1's interpolation error of the
-  // pulse, h^2/8 max |v''| = 0.0099 m/s (measured 0.020 m/s, 20 % of the 0.1 m/s amplitude).
+  // The coupling's monitor at every row (series.csv): the largest and the rms velocity mismatch
+  // between a coupled DE and the continuum at its centre, and the velocity constraint, which
+  // holds to round-off (bound about 20x). On this mesh (h = 4a) the coarse mediator leaves the
+  // three DE planes between node planes free, and the mismatch is of the order of P1's
+  // interpolation error of the pulse, h^2/8 max |v''| = 0.0099 m/s (bounds 1.5x the measured
+  // largest and rms mismatch, cases/wave_bar_coupled/README.md).
+  struct Monitor {
+    double residual = 0.0, mismatch = 0.0, mismatch_rms = 0.0;
+  };
   const auto monitor = [] {
-    double residual = 0.0, mismatch = 0.0;
+    Monitor m;
     const auto rows = test::read_csv(test::scratch_path(case_folder("wave_bar_coupled")) / "series.csv");
     EXPECT_GT(rows.size(), 10u);
     for (const auto& row : rows) {
-      residual = std::max(residual, test::number(row, "G_residual"));
-      mismatch = std::max(mismatch, test::number(row, "V_mismatch_max"));
-      EXPECT_LE(test::number(row, "V_mismatch_rms"), test::number(row, "V_mismatch_max"));
+      m.residual = std::max(m.residual, test::number(row, "G_residual"));
+      m.mismatch = std::max(m.mismatch, test::number(row, "V_mismatch_max"));
+      m.mismatch_rms = std::max(m.mismatch_rms, test::number(row, "V_mismatch_rms"));
     }
-    EXPECT_LT(residual, 1e-10);
-    return mismatch;
+    EXPECT_LT(m.residual, 1e-14);
+    return m;
   };
-  const double mismatch_h4 = monitor();
-  EXPECT_GT(mismatch_h4, 0.0);
-  EXPECT_LT(mismatch_h4, 0.3 * 0.1);
+  const Monitor h4 = monitor();
+  EXPECT_LT(h4.mismatch, 0.032);
+  EXPECT_LT(h4.mismatch_rms, 0.0086);
+  EXPECT_GT(h4.mismatch_rms, 0.0);
   // The lattice (119 x 5 x 5) and the mesh (x >= 2a) cover the bar; the overlap 22a..30a cuts
   // them: DEs up to x = 30a (31 x 25), tetrahedra from 22a on (5 elements of h = 4a, 6 each, go).
   const Json& counts = coarse.at("counts");
@@ -647,8 +653,8 @@ TEST(Cases, WaveBarCoupledTransmitsThePulse) {
   // Matched (h = a), lambda = 20a >= 5a: R <= 0.3 %.
   const Json matched = run_case("wave_bar_coupled", "--set continuum.mesh.file=../../meshes/coupled_bar_h1.geo");
   EXPECT_LE(matched.at("checks").at(0).at("value").get<double>(), 0.003);
-  // Every coupled DE on a node: tied one by one, no mismatch but round-off (5.6e-17 m/s).
-  EXPECT_LT(monitor(), 1e-12 * 0.1);
+  // Every coupled DE on a node: tied one by one, no mismatch but round-off.
+  EXPECT_LT(monitor().mismatch, 1e-15);
   // Natural neighbours by swapping the solver only, at 1.6 lambda_c on h = 4a and on h = 2a
   // (lambda_c = 6a, 1.6 lambda_c = 9.6a): R <= 0.5 % with the case's stabilization (README).
   const std::string nem = "--set continuum.solver=nem";
@@ -700,6 +706,81 @@ TEST(Cases, PulseDisplacementIsTheIntegralOfItsVelocity) {
     EXPECT_LT(worst, 1e-3 * A) << cycles;  // O((k a)^2) of the central difference
     EXPECT_NEAR(u(p.size() - 1), 0.0, 1e-15) << cycles;  // ahead
     EXPECT_NEAR(u(0), cycles ? 0.0 : A * lambda / (2 * c), 1e-12) << cycles;  // behind
+  }
+}
+
+// Results independent of the thread count, to the bit, for whole runs (not only the bond pass):
+// a breaking lattice bar and a coupled bar, each large enough that its bond pass runs on
+// threads (above common/parallel.hpp's threshold), on one and two threads: series.csv and
+// breaks.csv byte for byte.
+TEST(Cases, WholeRunsAreBitIdenticalOnOneAndTwoThreads) {
+  struct Run {
+    std::string name, args;
+    bool needs_continuum;
+  };
+  const std::vector<Run> runs = {
+      {"lattice_bar_failure", "lattice_bar_failure/case.yaml --set \"dem.sample.counts=[16,16,20]\"", false},
+      {"wave_bar_coupled", "wave_bar_coupled/case.yaml --set \"coupling.overlap.box=[[0.200, -0.001, -0.001], [0.216, 0.009, 0.009]]\" "
+                           "--set \"groups=[{name: dem_only, region: {box: [[-1, -1, -1], [0.199, 1, 1]]}}, {name: bar, region: "
+                           "{box: [[-1, -1, -1], [1, 1, 1]]}}]\" --set \"sensors=[{name: E_dem_side, type: energy, group: dem_only}]\"",
+       true}};
+  // The runs inherit this process's OMP_NUM_THREADS; the previous value is put back however
+  // the test ends.
+  struct RestoreThreads {
+    const char* before = std::getenv("OMP_NUM_THREADS");
+    std::string value = before ? before : "";
+    ~RestoreThreads() { before ? setenv("OMP_NUM_THREADS", value.c_str(), 1) : unsetenv("OMP_NUM_THREADS"); }
+  } restore;
+  for (const Run& run : runs) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+    if (run.needs_continuum) continue;
+#endif
+    std::string series[2], breaks[2];
+    for (int threads : {1, 2}) {
+      setenv("OMP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+      const auto out = test::scratch_dir("threads_" + run.name + "_" + std::to_string(threads));
+      const auto r = test::run_arlequin("run " + cases + run.args + " --quiet --set output.fields=[] --set checks=[] --out " + out.string());
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      series[threads - 1] = test::read_text(out / "series.csv");
+      breaks[threads - 1] = test::read_text(out / "breaks.csv");  // empty where nothing broke
+    }
+    EXPECT_GT(std::count(series[0].begin(), series[0].end(), '\n'), 10) << run.name;
+    EXPECT_EQ(series[0], series[1]) << run.name;
+    EXPECT_EQ(breaks[0], breaks[1]) << run.name;
+    if (run.name == "lattice_bar_failure") {
+      EXPECT_GT(std::count(breaks[0].begin(), breaks[0].end(), '\n'), 100);
+    }
+  }
+}
+
+// A coupled run's energy bookkeeping, read from series.csv: E_balance (with the coupling's
+// work) over the largest E_total, and W_coupling, the multipliers' work, which is zero in exact
+// arithmetic. The wave bar's balance is velocity Verlet's oscillation (bound 1.5x what fe and
+// nem achieve); the static patch's and W_coupling are round-off (bound about 20x).
+TEST(Cases, CoupledRunsCloseTheirEnergyBalance) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  struct Run {
+    std::string case_name, solver;
+    double balance_bound, coupling_work_bound;
+  };
+  for (const Run& run : std::vector<Run>{{"wave_bar_coupled", "fe", 3.5e-5, 2e-15},
+                                         {"wave_bar_coupled", "nem", 5.4e-5, 2e-15},
+                                         {"patch_coupled", "fe", 2.4e-12, 2e-16},
+                                         {"patch_coupled", "nem", 1.3e-12, 2e-16}}) {
+    const auto out = test::scratch_dir("energy_" + run.case_name + "_" + run.solver);
+    const auto r = test::run_arlequin("run " + cases + run.case_name + "/case.yaml --quiet --set output.fields=[] --set continuum.solver=" +
+                                      run.solver + " --out " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    double balance = 0.0, coupling_work = 0.0, energy = 0.0;
+    for (const auto& row : test::read_csv(out / "series.csv")) {
+      balance = std::max(balance, std::abs(test::number(row, "E_balance")));
+      coupling_work = std::max(coupling_work, std::abs(test::number(row, "W_coupling")));
+      energy = std::max(energy, std::abs(test::number(row, "E_total")));
+    }
+    EXPECT_LE(balance, run.balance_bound * energy) << run.case_name << " " << run.solver;
+    EXPECT_LE(coupling_work, run.coupling_work_bound * energy) << run.case_name << " " << run.solver;
   }
 }
 

@@ -285,13 +285,16 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
       EXPECT_EQ(row.at("broke"), "1");
     }
     EXPECT_LT(test::number(row, "final_stress"), 0.9 * test::number(row, "failure_stress")) << test;
-    EXPECT_NEAR(test::number(row, "failure_strain"), 9.6e-3, 3.0e-3) << test;
-    EXPECT_NEAR(test::number(row, "failure_stress"), 1.30e9, 0.3 * 1.30e9) << test;
+    // Bounds 1.4x the largest deviation of the four criteria on this sample: the peak within
+    // 12 % of the rule of mixtures, the strain at it within 1.0e-3 of the four's mean.
+    EXPECT_NEAR(test::number(row, "failure_strain"), 10.6e-3, 1.0e-3) << test;
+    EXPECT_NEAR(test::number(row, "failure_stress"), 1.30e9, 0.12 * 1.30e9) << test;
     EXPECT_GT(test::number(row, "fracture_energy"), 0.0) << test;
     const auto run = dir / "out" / "rev_10k" / test;
     const Json j = read_json_file(run / "test.json");
-    for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GE(j.at("broken_at_end").at(set).get<double>(), 0.0) << set;
-    EXPECT_GT(j.at("broken_at_end").at("fibre").get<double>(), j.at("broken_at_peak").at("fibre").get<double>()) << test;
+    // Damage spreads to every bond set after the peak, and most of the fibre's breaks come after it.
+    for (const char* set : {"fibre", "matrix", "interface"}) EXPECT_GT(j.at("broken_at_end").at(set).get<double>(), 0.0) << set;
+    EXPECT_GT(j.at("broken_at_end").at("fibre").get<double>(), 2.0 * j.at("broken_at_peak").at("fibre").get<double>()) << test;
     for (const char* f : {"failure.png", "fields.xdmf", "breaks.csv"}) EXPECT_TRUE(std::filesystem::exists(run / f)) << test << " " << f;
   }
 }
@@ -402,11 +405,11 @@ TEST(VirtualTests, EveryTestIsReadBeforeTheFirstRuns) {
 }
 
 // The REV of cases/rev_elastic reduced to ~2.4k DEs (mean radius 75 um: the matrix between the
-// fibre and a face is about one DE thick), all four tests through the command line. Looser
-// bounds than R3's (which need >= 40k DEs): E_L within 15 % of the rule of mixtures, nu_LT
-// 0.29 +- 0.04, E_T, G_LT, G_TT' within -20 % / +75 % of the seed's FEM row (coarse samples are
-// stiffer across the fibre: +26 %, +50 %, +33 % at this size, +11 %, +15 %, +16 % at 40k DEs),
-// nu_TT' in [0.2, 0.45].
+// fibre and a face is about one DE thick), all four tests through the command line. R3's bounds
+// need >= 40k DEs; this sample is stiffer across the fibre than the seed's FEM row (coarse
+// samples are), so its transverse moduli are held in bands of +-10 points around its own ratio
+// to that row; E_L within 1.4x its deviation from the rule of mixtures, nu_LT and nu_TT' within
+// 0.03 of the seed's 0.29 and of this sample's 0.30 (the values: the composite table it writes).
 TEST(RevElastic, ReducedRevGivesTheCompositeConstants) {
   const auto dir = test::scratch_dir("rev_reduced");
   write(dir / "spec.yaml",
@@ -425,14 +428,14 @@ TEST(RevElastic, ReducedRevGivesTheCompositeConstants) {
   EXPECT_NE(table.find("| seed FEM | | 134 | 10.7 |"), std::string::npos) << table;
   EXPECT_NE(table.find("| DEM reduced |"), std::string::npos) << table;
   const RevConstants c = rev_constants(dir / "out" / "tests.csv");
-  EXPECT_NEAR(c.E_L, 135.06e9, 0.15 * 135.06e9);
-  EXPECT_NEAR(c.nu_LT, 0.29, 0.04);
-  EXPECT_GT(c.nu_TT, 0.2);
-  EXPECT_LT(c.nu_TT, 0.45);
-  for (auto [value, fem] : {std::pair{c.E_T, 10.7e9}, {c.G_LT, 2.32e9}, {c.G_TT, 2.21e9}}) {
-    EXPECT_GT(value, 0.8 * fem);
-    EXPECT_LT(value, 1.75 * fem);
-  }
+  EXPECT_NEAR(c.E_L, 135.06e9, 0.105 * 135.06e9);
+  EXPECT_NEAR(c.nu_LT, 0.29, 0.028);
+  EXPECT_NEAR(c.nu_TT, 0.30, 0.03);
+  struct Band {
+    double value, fem, ratio;  // the sample's ratio to the seed's FEM row
+  };
+  for (const Band& b : {Band{c.E_T, 10.7e9, 1.26}, Band{c.G_LT, 2.32e9, 1.50}, Band{c.G_TT, 2.21e9, 1.33}})
+    EXPECT_NEAR(b.value / b.fem, b.ratio, 0.10) << b.value;
   for (const auto& row : test::read_csv(dir / "out" / "tests.csv")) EXPECT_LT(test::number(row, "force_imbalance"), 0.02) << row.at("test");
 }
 

@@ -106,7 +106,9 @@ TEST(SpringFailure, BreaksAtTheMaximumElongation) {
 
 // A simple-cubic lattice (spacing a, compaction pi/6) stretched uniformly by eps along x: each
 // x-bond carries N = E S eps, so the applied stress is sigma_xx = N / a^2 and the other
-// components vanish. The virial stress of an interior DE must equal it (2 %).
+// components vanish. The virial stress of an interior DE, (1/V) sum of r (x) f over its bonds with
+// V = a^3 (its sphere over the compaction) and r the stretched arm a (1 + eps), is that stress
+// times (1 + eps), exactly (to round-off).
 TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
   DemModel model;
   const double R = 1e-3, a = 2 * R, eps = 1e-4, E = 2e11;
@@ -118,7 +120,7 @@ TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
   const double S = std::numbers::pi * 0.25 * R * R;
   const double applied = E * S * eps / (a * a);
   const std::size_t centre = 2 + 5 * (2 + 5 * 2);
-  EXPECT_NEAR(sigma[centre][0], applied, 0.02 * applied);
+  EXPECT_NEAR(sigma[centre][0], applied * (1.0 + eps), 1e-12 * applied);
   for (int c = 1; c < 6; ++c) EXPECT_NEAR(sigma[centre][c], 0.0, 1e-9 * applied);
   EXPECT_NEAR(max_principal(sigma[centre]), sigma[centre][0], 1e-9 * applied);
   // Uniaxial: von Mises equals the axial stress, the hydrostatic stress a third of it.
@@ -278,6 +280,28 @@ TEST(BondColouring, ThreadsOnlyForLargeColoursInLargeScenes) {
   EXPECT_TRUE(chain_on_threads(large_colours, large_scene));
   EXPECT_FALSE(chain_on_threads(large_colours, large_scene - 1));
   EXPECT_FALSE(chain_on_threads(large_colours - 1, 10 * large_scene));
+}
+
+// A DE bonded to hundreds of others (a large DE among small ones; a particle table found it):
+// every bond at it needs a colour of its own. The colouring had a cap of 64 colours and threw;
+// it now colours any degree, and no two bonds at one DE share a colour.
+TEST(BondColouring, ColoursAStarOfThreeHundredBondsAndKeepsEachDeSBondsApart) {
+  std::vector<std::uint32_t> first, second;
+  for (std::uint32_t j = 1; j <= 300; ++j) first.push_back(0), second.push_back(j);  // the star
+  for (std::uint32_t j = 1; j < 300; ++j) first.push_back(j), second.push_back(j + 1);  // its rim, a chain
+  BondColouring colouring;
+  const std::vector<std::uint32_t> order = colouring.build(first, second, 301);
+  ASSERT_EQ(order.size(), first.size());
+  EXPECT_GE(colouring.offsets.size(), 301u);  // at least one colour per star bond
+  EXPECT_LE(colouring.offsets.size(), 2u * 302u);  // greedy: at most 2 d - 1 colours, d = 302
+  std::vector<std::vector<std::uint32_t>> colours_at(301);
+  for (std::size_t c = 0; c + 1 < colouring.offsets.size(); ++c)
+    for (std::uint32_t k = colouring.offsets[c]; k < colouring.offsets[c + 1]; ++k)
+      for (std::uint32_t de : {first[order[k]], second[order[k]]}) colours_at[de].push_back(std::uint32_t(c));
+  for (auto& colours : colours_at) {
+    std::sort(colours.begin(), colours.end());
+    EXPECT_EQ(std::adjacent_find(colours.begin(), colours.end()), colours.end());
+  }
 }
 
 #ifdef _OPENMP
