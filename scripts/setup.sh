@@ -15,7 +15,7 @@ packages=(g++ make cmake pkg-config libeigen3-dev petsc-dev openmpi-bin libcgal-
 fuzz=false
 if [[ ${1:-} == --fuzz ]]; then
   fuzz=true
-  packages+=(clang-14 libfuzzer-14-dev)
+  packages+=(clang-14 libclang-rt-14-dev libfuzzer-14-dev)  # compiler-rt: the sanitizers and libFuzzer runtimes
 fi
 missing=()
 for p in "${packages[@]}"; do
