@@ -273,12 +273,15 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
                                     "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string md = test::read_text(dir / "out" / "failure.md");
-  EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_bbf | | 1.30-1.42 | 8.86-10.00 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| seed Table 4 (#1-#3) | L_rdef | | 1.34-1.45 | 9.80-10.90 |"), std::string::npos) << md;
   const auto rows = test::read_csv(dir / "out" / "failure.csv");
   ASSERT_EQ(rows.size(), 4u);  // L_bbf, L_rdef, L_rdef_averaged, L_rdef_laguerre
   for (const auto& row : rows) {
     const std::string test = row.at("test");
+    // The table shows each run's own values (in GPa and 1e-3, as failure.csv has them in SI).
+    char values[64];
+    std::snprintf(values, sizeof values, "| %.3f | %.2f |", test::number(row, "failure_stress") / 1e9,
+                  test::number(row, "failure_strain") * 1e3);
+    EXPECT_NE(md.find("| rev_10k | " + test + " | " + row.at("particles") + " " + values), std::string::npos) << values << md;
     EXPECT_EQ(row.at("status"), "ok") << test;
     // BBF breaks abruptly (the stress falls below half its peak); RDEF softens more gradually.
     if (test == "L_bbf") {
@@ -425,9 +428,13 @@ TEST(RevElastic, ReducedRevGivesTheCompositeConstants) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string table = test::read_text(dir / "out" / "composite.md");
   EXPECT_NE(table.find("| theory (ROM; Hashin K23; Halpin-Tsai) | | 135.1 |"), std::string::npos) << table;
-  EXPECT_NE(table.find("| seed FEM | | 134 | 10.7 |"), std::string::npos) << table;
-  EXPECT_NE(table.find("| DEM reduced |"), std::string::npos) << table;
   const RevConstants c = rev_constants(dir / "out" / "tests.csv");
+  // The DEM row shows the sample's own moduli (GPa, 4 significant digits).
+  char shown[64];
+  std::snprintf(shown, sizeof shown, "| DEM reduced | 2415 | %.4g ± ", c.E_L * 1e-9);
+  EXPECT_NE(table.find(shown), std::string::npos) << shown << table;
+  std::snprintf(shown, sizeof shown, "| %.4g ± ", c.E_T * 1e-9);
+  EXPECT_NE(table.find(shown), std::string::npos) << shown << table;
   EXPECT_NEAR(c.E_L, 135.06e9, 0.105 * 135.06e9);
   EXPECT_NEAR(c.nu_LT, 0.29, 0.028);
   EXPECT_NEAR(c.nu_TT, 0.30, 0.03);
@@ -467,8 +474,13 @@ TEST(ValidationRev, CalibrationReproducesTable1Materials) {
   }
 }
 
-// R4 on the 40k-DE REV, longitudinal tension to failure: sigma_fail 1.30-1.50 GPa and eps_fail
-// (9.6 +- 1.0)e-3 for both criteria, RDEF failing at a larger strain than BBF.
+// R4 on the 40k-DE REV, longitudinal tension to failure (docs/validation.md#r4, as decided):
+// BBF sigma_fail 1.30-1.50 GPa at eps_fail (9.6 +- 1.0)e-3; RDEF, the seed's criterion as written
+// (per DE, its own volume share), sigma_fail within 10 % of the seed's RDEF range (1.21-1.60 GPa)
+// and eps_fail above BBF's. The averaged and Laguerre variants the README quotes are options, not
+// the seed's criterion: held to the same stress band and to the strain window of the seed's
+// RDEF and BBF rows widened by R4's 1e-3 (7.9-11.9e-3); they fail before BBF (README), which is
+// why they are not R4's RDEF.
 TEST(ValidationRev, Rev40kFailureMatchesSeedTable4) {
   const auto dir = test::scratch_dir("rev_40k_failure");
   const auto r = test::run_arlequin("virtual-test " + (std::filesystem::path(ARLEQUIN_SOURCE_DIR) / "cases" / "rev_failure" /
@@ -478,14 +490,20 @@ TEST(ValidationRev, Rev40kFailureMatchesSeedTable4) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::map<std::string, std::map<std::string, std::string>> by_test;
   for (const auto& row : test::read_csv(dir / "failure.csv")) by_test[row.at("test")] = row;
-  for (const char* test : {"L_bbf", "L_rdef"}) {
-    const auto& row = by_test.at(test);
-    EXPECT_EQ(row.at("status"), "ok") << test;
-    EXPECT_GE(test::number(row, "failure_stress"), 1.30e9) << test;
-    EXPECT_LE(test::number(row, "failure_stress"), 1.50e9) << test;
-    EXPECT_NEAR(test::number(row, "failure_strain"), 9.6e-3, 1.0e-3) << test;
+  ASSERT_EQ(by_test.size(), 4u);
+  for (const auto& [test, row] : by_test) EXPECT_EQ(row.at("status"), "ok") << test;
+  const auto stress = [&](const char* test) { return test::number(by_test.at(test), "failure_stress"); };
+  const auto strain = [&](const char* test) { return test::number(by_test.at(test), "failure_strain"); };
+  EXPECT_GE(stress("L_bbf"), 1.30e9);
+  EXPECT_LE(stress("L_bbf"), 1.50e9);
+  EXPECT_NEAR(strain("L_bbf"), 9.6e-3, 1.0e-3);
+  for (const char* rdef : {"L_rdef", "L_rdef_averaged", "L_rdef_laguerre"}) {
+    EXPECT_GE(stress(rdef), 1.21e9) << rdef;
+    EXPECT_LE(stress(rdef), 1.60e9) << rdef;
+    EXPECT_GE(strain(rdef), 7.9e-3) << rdef;
+    EXPECT_LE(strain(rdef), 11.9e-3) << rdef;
   }
-  EXPECT_GT(test::number(by_test.at("L_rdef"), "failure_strain"), test::number(by_test.at("L_bbf"), "failure_strain"));
+  EXPECT_GT(strain("L_rdef"), strain("L_bbf"));
 }
 
 // R3 on the 40k-DE REV: E_L within -5 % / +15 % of 135.06 GPa, nu_LT 0.29 +- 0.02, E_T, G_LT and
