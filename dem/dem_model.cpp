@@ -303,16 +303,6 @@ void DemModel::apply_failures(bool record_energy) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
-  if (contact_) {
-    // check_contact_resolution's critical step of the contacts a DE has now: its bonds' row
-    // of the bound (set-up values: a break only lowers it) plus its touching contacts'.
-    const std::size_t n = particles.size();
-    bond_frequency_bound_.assign(n, 0.0);
-    std::vector<double> rot(n, 0.0);
-    for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, bond_frequency_bound_, rot);
-    inv_mass_max_ = n > 0 ? *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end()) : 0.0;
-    touching_.assign(n, 0);
-  }
   ForceScan scan;
   scan.energy = record_energy;
   compute_forces(scan);
