@@ -118,9 +118,9 @@ constexpr SchemaSection dem_sections[] = {
     {"dem.failure.rdef.material_thresholds", "RDEF threshold per material", material_threshold_keys},
 };
 
-// A lattice, chain or packing of `des` DEs that cannot fit in this machine's memory is refused at `key`
-// before it is built: a DE's state takes about 200 B (dem/particles.hpp, structure of arrays)
-// and a lattice DE's three bonds at least 100 B each, so 500 B per DE is a floor.
+// A lattice, chain or packing of `des` DEs that cannot fit in this machine's memory is refused
+// at `key` before it is built: a DE's state takes about 200 B (dem/particles.hpp, structure of
+// arrays) and a lattice DE's three bonds at least 100 B each, so 500 B per DE is a floor.
 void refuse_beyond_memory(CaseNode& sample, const char* key, double des) {
   constexpr double kBytesPerDe = 500.0;
   if (const std::string beyond = beyond_memory(des * kBytesPerDe, "about 500 B per DE with its bonds"); !beyond.empty()) {
@@ -173,7 +173,6 @@ void read_packing(CaseNode sample, Scene& scene, double density, const SceneOpti
   }
   if (options.write_sample_cache) dem::save_sample(file, p, spec, scene.sample->report);
 }
-
 
 // build: particles, table: FILE.csv. Header x,y,z,radius with optional vx,vy,vz (in that
 // order); each further line one DE. InputError at FILE:LINE for a row that is not those numbers.
