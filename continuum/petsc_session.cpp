@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "continuum/petsc_session.hpp"
 
+#include <cstdlib>
+
 #include <petscsys.h>
 
 #include "common/error.hpp"
@@ -12,6 +14,10 @@ bool g_started = false;
 }
 
 PetscSession::PetscSession(const std::string& options) {
+  // MPI_Init runs hwloc's topology discovery, which prints three lines to stderr where /sys is
+  // not mounted (containers, chroots) and discovers nothing we use: a one-line error of ours
+  // would come with them. Its messages are hidden unless the user set HWLOC_HIDE_ERRORS.
+  setenv("HWLOC_HIDE_ERRORS", "2", /*overwrite=*/0);
   // No argc/argv: options reach PETSc through the string only, so the application decides
   // which command-line words are PETSc's.
   petsc_check(PetscInitialize(nullptr, nullptr, nullptr, nullptr), "PetscInitialize");
