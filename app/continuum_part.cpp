@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <sstream>
 #include <vector>
 
 #include "common/case_file.hpp"
@@ -67,6 +68,8 @@ constexpr KeyDoc coupling_keys[] = {
      "plain | consistent"},
     {"solver", KeyType::choice, "", {}, "petsc", "the multiplier solve: PETSc (options below) or our sparse LDL^T", "petsc | direct"},
     {"petsc_options", KeyType::string, "", {}, "", "solver: petsc: PETSc options of the multiplier system (prefix coupling_)"},
+    {"on_damage_in_overlap", KeyType::choice, "", {}, "stop",
+     "a bond the coupling weights (weight < 1) breaks: stop the run, or say so once and go on", "stop | warn"},
 };
 constexpr KeyDoc overlap_keys[] = {
     {"shell", KeyType::section, "", {}, "(none)", "the space between two boxes, the DEM inside (instead of a region)"},
@@ -132,6 +135,7 @@ struct CouplingCaseSettings {
   CaseNode node;  // the section: the coupling library's errors are reported at their key
   coupling::OverlapZone zone;
   coupling::CoupledOptions options{};
+  bool stop_on_damage_in_overlap = true;
 };
 
 // An error of the coupling library at its key in the case's coupling section: a SettingError
@@ -255,6 +259,8 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   out.options.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
   if (out.options.coupling.type == coupling::CouplingType::h1)
     out.options.coupling.length = section.number("length", Range::positive(), "m");
+  static constexpr std::string_view on_damage[] = {"stop", "warn"};
+  out.stop_on_damage_in_overlap = section.choice_or("on_damage_in_overlap", "stop", on_damage) == "stop";
   static constexpr std::string_view quadratures[] = {"plain", "consistent"};
   out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
   static constexpr std::string_view solvers[] = {"petsc", "direct"};
@@ -272,9 +278,21 @@ CouplingCaseSettings read_coupling(CaseNode section) {
 // finalized the DEM; the continuum part keeps its solver, this model the coupling.
 class Coupled final : public SceneModel {
  public:
-  Coupled(dem::DemModel& dem, const ContinuumPart& continuum, std::unique_ptr<coupling::CoupledModel> model)
-      : dem_(dem), continuum_(continuum), model_(std::move(model)) {}
+  Coupled(dem::DemModel& dem, const ContinuumPart& continuum, std::unique_ptr<coupling::CoupledModel> model,
+          bool stop_on_damage_in_overlap)
+      : dem_(dem), continuum_(continuum), model_(std::move(model)), stop_on_damage_(stop_on_damage_in_overlap) {}
   void step(double dt) override { model_->step(dt); }
+  std::optional<OverlapDamageReport> damage_in_overlap() override {
+    const auto damage = model_->damage_in_overlap();
+    if (!damage) return std::nullopt;
+    const dem::BreakEvent& e = damage->first;
+    const dem::BondSet& set = *dem_.bond_sets()[e.set];
+    std::ostringstream line;
+    line << "damage reached the coupling overlap: bond " << e.bond << " of '" << set.name << "' (DEs " << set.first()[e.bond]
+         << " and " << set.second()[e.bond] << ") broke at t = " << e.time << " s where the DEM's weight is " << damage->weight;
+    if (damage->breaks > 1) line << " (and " << damage->breaks - 1 << " more there in the step)";
+    return OverlapDamageReport{line.str(), damage->breaks, stop_on_damage_};
+  }
   double critical_time_step() const override { return model_->critical_time_step(); }
   SceneEnergies energies() const override {
     return {dem_.energies(), continuum_.kinetic_energy(), continuum_.strain_energy(), model_->coupling_work()};
@@ -294,6 +312,7 @@ class Coupled final : public SceneModel {
   const dem::DemModel& dem_;
   const ContinuumPart& continuum_;
   std::unique_ptr<coupling::CoupledModel> model_;
+  bool stop_on_damage_;  // coupling.on_damage_in_overlap
 };
 
 class Part final : public ContinuumPart {
@@ -335,7 +354,8 @@ class Part final : public ContinuumPart {
     options.held_continuum_dofs = held_dofs_;
     options.driven_des = dem.driven_particles();
     try {
-      return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, coupling_->zone, options));
+      return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, coupling_->zone, options),
+                                       coupling_->stop_on_damage_in_overlap);
     } catch (const InputError& e) {  // the coupling's own checks (DEs in the overlap, masses, quadrature)
       fail_at_coupling_key(coupling_->node, e);
     }

@@ -416,6 +416,15 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       ++steps_done;
       if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
       model.check_finite();
+      if (const auto damage = scene.model->damage_in_overlap()) {
+        const bool first = result.damage_in_overlap.empty();
+        if (first) result.damage_in_overlap = "step " + std::to_string(n) + ": " + damage->description;
+        result.damage_in_overlap_breaks += damage->breaks;
+        if (damage->stop)
+          throw RunError(result.damage_in_overlap + "; the run stops (coupling.on_damage_in_overlap: stop; warn goes on)");
+        if (first)
+          std::fprintf(stderr, "  warning: %s; the run goes on (coupling.on_damage_in_overlap: warn)\n", result.damage_in_overlap.c_str());
+      }
       if (n % 50 == 0 || n == total_steps)
         model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
                                     std::abs(model.external_work())) +
@@ -445,6 +454,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["status"] = failure.empty() ? "completed" : interrupted ? "interrupted" : "failed";
   if (!failure.empty()) summary["error"] = failure;
   if (!result.stop_reason.empty()) summary["stopped_early"] = result.stop_reason;
+  if (!result.damage_in_overlap.empty()) {
+    summary["damage_in_overlap"] = result.damage_in_overlap;
+    summary["damage_in_overlap_breaks"] = result.damage_in_overlap_breaks;
+  }
   summary["steps"] = result.steps;
   summary["simulated_time"] = result.simulated_time;
   summary["dt"] = scene.dt;

@@ -37,6 +37,8 @@ struct RunResult {
   dem::Energies energies;
   std::vector<std::pair<std::string, double>> sensors;  // last value of each column
   std::string stop_reason;      // why stop_after_row ended the run early (empty: it did not)
+  std::string damage_in_overlap;  // the first break where the coupling weights the bonds (empty: none)
+  std::size_t damage_in_overlap_breaks = 0;  // all such breaks
   struct CheckResult {
     const Check* check;
     double value;           // final value, or crossing time (NaN: never reached)

@@ -32,6 +32,15 @@ struct CouplingMonitorValues {
   double velocity_mismatch_max = 0.0;  // m/s
 };
 
+// Bonds that broke where the coupling weighted them since the last look (a coupled scene only):
+// one line for the user, and whether the case stops the run for it
+// (coupling.on_damage_in_overlap).
+struct OverlapDamageReport {
+  std::string description;  // of the first such break
+  std::size_t breaks = 0;   // all of them since the last look
+  bool stop = true;
+};
+
 class SceneModel {
  public:
   virtual ~SceneModel() = default;
@@ -39,6 +48,7 @@ class SceneModel {
   virtual double critical_time_step() const = 0;  // s; of the coupled system when coupled
   virtual SceneEnergies energies() const = 0;
   virtual std::optional<CouplingMonitorValues> monitor() const = 0;  // nullopt: nothing coupled
+  virtual std::optional<OverlapDamageReport> damage_in_overlap() { return std::nullopt; }
   // The frame's fields: particles (and bonds, as the plan asks) and the continuum's.
   virtual void write_fields(FieldsWriter& fields, const OutputPlan& plan) const = 0;
   virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)

@@ -192,6 +192,21 @@ void CoupledModel::kick_to_trial(double dt) {
   continuum_.kick(0.5 * dt);
 }
 
+std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
+  const auto& breaks = dem_.breaks();
+  const auto& reference = dem_.particles.reference;
+  std::optional<OverlapDamage> damage;
+  for (; breaks_looked_at_ < breaks.size(); ++breaks_looked_at_) {
+    const dem::BreakEvent& e = breaks[breaks_looked_at_];
+    const dem::BondSet& set = *dem_.bond_sets()[e.set];
+    const double weight = zone_.alpha_d(0.5 * (reference[set.first()[e.bond]] + reference[set.second()[e.bond]]));
+    if (!(weight < 1.0)) continue;
+    if (!damage) damage = OverlapDamage{0, e, weight};
+    ++damage->breaks;
+  }
+  return damage;
+}
+
 void CoupledModel::solve_and_correct(double dt) {
   gather_dem_velocity(vd_);
   solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_);

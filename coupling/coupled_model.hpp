@@ -126,6 +126,14 @@ struct CouplingMonitor {
   double max_velocity_mismatch = 0.0;  // max of the same, m/s
 };
 
+// Bonds that broke where the coupling weighted them (their set-up midpoint in the overlap, the
+// DEM's weight there below 1): the coupling's operators assume that material intact.
+struct OverlapDamage {
+  std::size_t breaks = 0;  // such breaks since the last look
+  dem::BreakEvent first;   // the first of them
+  double weight = 1.0;     // alpha_d at its bond's midpoint
+};
+
 class CoupledModel {
  public:
   CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone,
@@ -149,6 +157,10 @@ class CoupledModel {
   CouplingMonitor monitor() const;
   // |G_d u_d + G_c u_c| / |G_d u_d| for the current displacements.
   double displacement_residual() const;
+
+  // The breaks since the last call whose bonds lie where the DEM's weight is below 1 (count and
+  // first; nullopt if none): each break of the DEM is looked at once.
+  std::optional<OverlapDamage> damage_in_overlap();
 
   const OverlapZone& zone() const { return zone_; }
   const CouplingOperators& operators() const { return ops_; }
@@ -175,6 +187,7 @@ class CoupledModel {
   dem::DemModel& dem_;
   continuum::ContinuumSolver& continuum_;
   OverlapZone zone_;
+  std::size_t breaks_looked_at_ = 0;  // damage_in_overlap()
   CoupledOptions options_;
   CouplingOperators ops_;
   std::unique_ptr<MultiplierSolver> solver_;

@@ -769,6 +769,46 @@ TEST(Cases, NemStabilizationHoldsOnASecondBar) {
   EXPECT_EQ(plain.exit_code, 5) << plain.output;
 }
 
+// A bond that the coupling weights (weight < 1 at its set-up midpoint) breaking: the run says so
+// in one line and in summary.json, and stops (coupling.on_damage_in_overlap: stop, the default)
+// or goes on (warn). Breaks in the pure-DEM zone of a coupled run say nothing.
+TEST(Cases, DamageInTheOverlapStopsOrWarnsAndDamageElsewhereDoesNot) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("overlap_damage");
+  // The patch starts on a uniform strain of 1e-3 (200 MPa in the bonds): with sigma_f = 10 MPa
+  // bonds break at the first step, in the overlap too.
+  const std::string patch = "run " + cases + "patch_coupled/case.yaml --quiet --set output.fields=[] --set checks=[] --set dem.bond.sigma_f=1e7 ";
+  const auto stopped = test::run_arlequin(patch + "--out " + (out / "stop").string());
+  EXPECT_EQ(stopped.exit_code, 3) << stopped.output;
+  EXPECT_NE(stopped.output.find("step 1: damage reached the coupling overlap: bond "), std::string::npos) << stopped.output;
+  EXPECT_NE(stopped.output.find("the run stops (coupling.on_damage_in_overlap: stop"), std::string::npos) << stopped.output;
+  const Json s = read_json_file(out / "stop" / "summary.json");
+  EXPECT_EQ(s.at("status").get<std::string>(), "failed");
+  EXPECT_EQ(s.at("steps").get<long>(), 1);
+  EXPECT_GT(s.at("damage_in_overlap_breaks").get<long>(), 0);
+
+  const auto warned = test::run_arlequin(patch + "--set coupling.on_damage_in_overlap=warn --out " + (out / "warn").string());
+  EXPECT_EQ(warned.exit_code, 0) << warned.output;
+  EXPECT_EQ(std::count(warned.output.begin(), warned.output.end(), '\n'), 1) << warned.output;
+  EXPECT_EQ(warned.output.rfind("  warning: step 1: damage reached the coupling overlap", 0), 0u) << warned.output;
+  const Json w = read_json_file(out / "warn" / "summary.json");
+  EXPECT_EQ(w.at("status").get<std::string>(), "completed");
+  EXPECT_GT(w.at("damage_in_overlap_breaks").get<long>(), s.at("damage_in_overlap_breaks").get<long>());
+
+  // A tensile pulse breaking bonds in the pure-DEM zone of the wave bar, the overlap far ahead.
+  const auto elsewhere = test::run_arlequin(
+      "run " + cases + "wave_bar_coupled/case.yaml --quiet --set output.fields=[] --set checks=[] --set time.end=3e-5 "
+      "--set pulse.amplitude=-0.1 --set dem.bond.sigma_f=3e6 --set \"coupling.overlap.box=[[0.200, -0.001, -0.001], [0.216, 0.009, 0.009]]\" "
+      "--set \"groups=[{name: dem_only, region: {box: [[-1, -1, -1], [0.199, 1, 1]]}}, {name: bar, region: {box: [[-1, -1, -1], "
+      "[1, 1, 1]]}}]\" --set \"sensors=[{name: E_dem_side, type: energy, group: dem_only}]\" --out " + (out / "elsewhere").string());
+  EXPECT_EQ(elsewhere.exit_code, 0) << elsewhere.output;
+  const Json e = read_json_file(out / "elsewhere" / "summary.json");
+  EXPECT_GT(e.at("counts").at("broken_bonds").get<long>(), 100);
+  EXPECT_FALSE(e.contains("damage_in_overlap"));
+}
+
 // A coupled run's energy bookkeeping, read from series.csv: E_balance (with the coupling's
 // work) over the largest E_total, and W_coupling, the multipliers' work, which is zero in exact
 // arithmetic. The wave bar's balance is velocity Verlet's oscillation (bound 1.5x what fe and
