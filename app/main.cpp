@@ -340,12 +340,7 @@ int calibrate(const Arguments& a) {
 }
 
 int check(const Arguments& a) {
-  app::SceneOptions options = a.scene;
-  // Validating a case writes nothing (no output folder, no packing cache), so it may run where
-  // nothing can be written.
-  options.check_output_dir = false;
-  options.write_sample_cache = false;
-  app::Scene scene = app::build_scene(a.case_file, options);
+  app::Scene scene = app::build_scene(a.case_file, app::writing_nothing(a.scene));
   std::printf("# %s: valid\n%s\n", a.case_file.c_str(), scene.resolved_case.c_str());
   print_scene_facts(scene);
   return 0;

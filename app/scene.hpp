@@ -121,6 +121,14 @@ struct SceneOptions {
   bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
 };
 
+// The options of `arlequin check` (and of the fuzz targets, which read as it does): those given,
+// writing nothing, so that a case is validated where nothing can be written.
+inline SceneOptions writing_nothing(SceneOptions options) {
+  options.check_output_dir = false;
+  options.write_sample_cache = false;
+  return options;
+}
+
 // Column names of series.csv for the scene's sensors (one, or three for component: all).
 std::vector<std::string> sensor_columns(const Scene& scene);
 // The unit of each of those columns: N, m, m/s, J, or 1 (affine deviation).

@@ -30,14 +30,15 @@ inline double& memory_budget_bytes() {
 }
 
 // Empty if `bytes` fits in the physical memory (or it is unknown) and the budget; else the
-// sentence to add to an error: "which needs at least X (WHY); this machine has Y".
+// sentence to add to an error: "which needs at least X (WHY); this machine has Y" (or "the
+// memory budget is Y" where the budget is the smaller).
 inline std::string beyond_memory(double bytes, const std::string& why) {
-  const double budget = memory_budget_bytes();
-  if (budget > 0.0 && bytes > budget)
-    return "which needs at least " + gigabytes(bytes) + " (" + why + "); the memory budget is " + gigabytes(budget);
-  const double have = physical_memory_bytes();
-  if (have <= 0.0 || bytes <= have) return {};
-  return "which needs at least " + gigabytes(bytes) + " (" + why + "); this machine has " + gigabytes(have);
+  const double budget = memory_budget_bytes(), have = physical_memory_bytes();
+  const bool budgeted = budget > 0.0 && (have <= 0.0 || budget < have);
+  const double limit = budgeted ? budget : have;
+  if (limit <= 0.0 || bytes <= limit) return {};
+  return "which needs at least " + gigabytes(bytes) + " (" + why + "); " +
+         (budgeted ? "the memory budget is " : "this machine has ") + gigabytes(limit);
 }
 
 }  // namespace arlequin

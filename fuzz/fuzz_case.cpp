@@ -12,11 +12,6 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto file = arlequin::fuzz::write_input("case.yaml", data, size);
-  arlequin::fuzz::expect_refusal_at_most([&] {
-    arlequin::app::SceneOptions options;
-    options.check_output_dir = false;
-    options.write_sample_cache = false;
-    arlequin::app::build_scene(file, options);
-  });
+  arlequin::fuzz::expect_refusal_at_most([&] { arlequin::app::build_scene(file, arlequin::app::writing_nothing({})); });
   return 0;
 }

@@ -26,11 +26,6 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   arlequin::fuzz::write_input("table.csv", data, size);
-  arlequin::fuzz::expect_refusal_at_most([&] {
-    arlequin::app::SceneOptions options;
-    options.check_output_dir = false;
-    options.write_sample_cache = false;
-    arlequin::app::build_scene(arlequin::fuzz::scratch() / "table_case.yaml", options);
-  });
+  arlequin::fuzz::expect_refusal_at_most([&] { arlequin::app::build_scene(arlequin::fuzz::scratch() / "table_case.yaml", arlequin::app::writing_nothing({})); });
   return 0;
 }
