@@ -305,6 +305,8 @@ class Coupled final : public SceneModel {
     continuum_.write_fields(fields);
     write_dem_fields(dem_, fields, plan);
   }
+  void save_state(StateArchive& archive) const override { model_->save_state(archive); }
+  void load_state(const StateArchive& archive) override { model_->load_state(archive); }
   std::string summary() const override { return model_->summary(); }
   void describe(Json& counts) const override { counts["coupled_particles"] = model_->operators().num_particles(); }
 
@@ -384,6 +386,8 @@ class Part final : public ContinuumPart {
   double strain_energy() const override { return solver_->strain_energy(); }
   double external_work() const override { return solver_->external_work(); }
   double verlet_correction(double dt) const override { return solver_->verlet_correction(dt); }
+  void save_state(StateArchive& archive) const override { solver_->save_state(archive, "continuum/"); }
+  void load_state(const StateArchive& archive) override { solver_->load_state(archive, "continuum/"); }
 
   void write_fields(FieldsWriter& fields) const override {
     const auto& mesh = solver_->mesh();

@@ -75,6 +75,9 @@ class ContinuumPart {
   // Verlet's shadow correction at step dt (ContinuumSolver::external_work, verlet_correction).
   virtual double external_work() const = 0;
   virtual double verlet_correction(double dt) const = 0;
+  // The continuum's state alone (an uncoupled scene; a coupled one saves it with the coupling).
+  virtual void save_state(StateArchive& archive) const = 0;
+  virtual void load_state(const StateArchive& archive) = 0;
   virtual void write_fields(FieldsWriter& fields) const = 0;
   virtual void describe(Json& counts) const = 0;
 };

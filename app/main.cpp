@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -23,6 +24,7 @@
 #include "common/error.hpp"
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
+#include "common/state_file.hpp"
 #include "dem/bonds/bond_set.hpp"
 #include "dem/contacts/contact_law.hpp"
 
@@ -51,8 +53,11 @@ constexpr const char* usage_main =
     "options: --version, --help; 'arlequin <command> --help' for a command's options\n";
 
 constexpr const char* usage_run =
-    "usage: arlequin run CASE.yaml [--out DIR] [--set key.path=value ...] [--steps N]\n"
+    "usage: arlequin run CASE.yaml [--out DIR] [--set key.path=value ...] [--steps N] [--restart FILE]\n"
     "  --out DIR      write results to DIR instead of output.dir of the case\n"
+    "  --restart FILE continue the run of checkpoint FILE (checkpoint.h5 of its output folder: written\n"
+    "                 on Ctrl-C or SIGTERM, and every output.checkpoint_every) into the output folder,\n"
+    "                 appending to series.csv and breaks.csv; the case may change only time.end and output\n"
     "  --set k=v      override a case value (YAML syntax), e.g. --set time.end=1e-3\n"
     "  --steps N      stop after N steps (before time.end the case's checks are not evaluated)\n"
     "  --petsc \"...\"  PETSc options of a static continuum solve (checked before the run), e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
@@ -110,6 +115,7 @@ struct Arguments {
   std::string second_case;  // compare
   app::SceneOptions scene;
   long steps = -1;
+  std::filesystem::path restart;  // run --restart
   std::vector<app::SweepAxis> axes;
   std::vector<std::string> samples;  // virtual-test --sample
   std::string document = "case";     // schema --of
@@ -154,6 +160,8 @@ Arguments parse(int argc, char** argv) {
       char* end = nullptr;
       a.steps = std::strtol(v.c_str(), &end, 10);
       if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+    } else if (arg == "--restart" && a.command == "run") {
+      a.restart = value("a checkpoint file");
     } else if (arg == "--of" && a.command == "schema") {
       a.document = value("case, virtual-test or calibrate");
       if (a.document != "case" && a.document != "virtual-test" && a.document != "calibrate")
@@ -245,13 +253,21 @@ void print_scene_facts(const app::Scene& scene) {
 
 int run(const Arguments& a) {
   const auto t0 = std::chrono::steady_clock::now();
+  // A checkpoint that cannot be read is refused before the scene is built.
+  const std::optional<StateArchive> restart = a.restart.empty() ? std::nullopt : std::optional(read_state_file(a.restart));
   app::Scene scene = app::build_scene(a.case_file, a.scene);
   app::RunOptions options;
+  if (restart) {
+    options.restart = &*restart;
+    options.restart_file = a.restart;
+  }
   options.max_steps = a.steps;
   options.show_progress = !a.quiet && isatty(STDERR_FILENO) && std::getenv("CI") == nullptr;
   options.announce_run_time = !a.quiet;
   options.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   print_scene_facts(scene);
+  if (restart && restart->has("run/steps_done"))
+    std::printf("  restart: from step %lld of %s\n", static_cast<long long>(restart->integer("run/steps_done")), a.restart.c_str());
   const app::RunResult r = app::run_scene(scene, options);
   std::printf("done: %ld steps, t = %.6e s, wall %.3f s (output %.3f s; %.0f steps/s without output), setup %.3f s\n",
               r.steps, r.simulated_time, r.wall_seconds, r.output_seconds, app::steps_per_second(r), options.setup_seconds);

@@ -54,6 +54,9 @@ constexpr KeyDoc output_keys[] = {
     {"fields", KeyType::strings, "", {}, "[]", "field sets written to fields.h5: particles, bonds, continuum"},
     {"fields_every", KeyType::number, "s", Range::positive(), "(every)", "interval of fields.h5 frames"},
     {"plots", KeyType::list, "", {}, "(none)", "plots of series columns, drawn by the Python package"},
+    {"checkpoint_every", KeyType::number, "s", Range::positive(), "(none)",
+     "interval of checkpoint.h5 (the whole state, for --restart), also written when the run ends; "
+     "without it only SIGINT or SIGTERM writes one"},
 };
 constexpr KeyDoc reference_keys[] = {
     {"label", KeyType::string, "", {}, "reference", "legend text"},
@@ -316,6 +319,7 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
       (f == "particles" ? plan.particle_fields : f == "bonds" ? plan.bond_fields : plan.continuum_fields) = true;
     }
     plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
+    plan.checkpoint_every = out->number_or("checkpoint_every", 0.0, Range::positive(), "s");
     for (CaseNode p : out->list_or_empty("plots")) {
       PlotPlan plot;
       plot.file = p.string("file");

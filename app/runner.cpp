@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "app/runner.hpp"
 
+#include "app/checkpoint.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,6 +20,7 @@
 #include "common/interrupt.hpp"
 #include "common/json.hpp"
 #include "common/plots.hpp"
+#include "common/state_file.hpp"
 #include "dem/crack_front.hpp"
 
 namespace arlequin::app {
@@ -39,25 +42,61 @@ double seconds_since(Clock::time_point t0) {
 }
 
 
-// Writes the output files of one run; every file is replaced atomically.
+// The fields file a run left in `dir`: fields.h5, or the .part file of a writer that was killed.
+std::filesystem::path earlier_fields_file(const std::filesystem::path& dir) {
+  std::filesystem::path found = dir / "fields.h5";
+  if (std::filesystem::exists(found)) return found;
+  std::error_code ec;
+  std::filesystem::file_time_type newest{};
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+    if (entry.path().filename().string().starts_with("fields.h5.part.") && entry.last_write_time(ec) >= newest)
+      newest = entry.last_write_time(ec), found = entry.path();
+  return found;
+}
+
+// Writes the output files of one run; every file is replaced atomically. A restarted run
+// (`restart`: the checkpoint read from the folder `checkpoint_dir`) starts from the rows and
+// frames the checkpoint counts.
 class Outputs {
  public:
-  Outputs(const Scene& scene) : scene_(scene) {
+  Outputs(const Scene& scene, const StateArchive* restart, const std::filesystem::path& checkpoint_dir) : scene_(scene) {
     std::error_code ec;
     std::filesystem::create_directories(scene.output.dir, ec);
     if (ec) throw InputError("cannot create the output folder '" + scene.output.dir.string() + "': " + ec.message());
+    const bool fields = scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields;
+    if (fields) fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+    // The frames before the restart, while a killed writer's file is still there.
+    if (fields && restart) carry_frames(*restart, checkpoint_dir);
     // A folder run before holds its outputs: what a killed writer left half done goes, and so
     // do the files this run will not write (fields of a run that had them, breaks of one with
-    // failure), so that no file of the folder is from another run than series.csv.
+    // failure, the checkpoint of another run), so that no file of the folder is from another run
+    // than series.csv.
     remove_stale_temporaries(scene.output.dir);
-    const bool fields = scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields;
     std::vector<const char*> not_written;
     if (!fields) not_written.insert(not_written.end(), {"fields.h5", "fields.xdmf"});
     if (!scene.dem.failure_enabled()) not_written.push_back("breaks.csv");
+    if (!restart) not_written.push_back(checkpoint_file_name);
     for (const char* name : not_written) std::filesystem::remove(scene.output.dir / name, ec);
     series_.emplace(scene.output.dir / "series.csv", series_columns(scene));
-    if (fields) fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+    if (restart) restore_rows(*restart);
     write_file_atomically(scene.output.dir / "case.resolved.yaml", scene.resolved_case);
+  }
+
+  // The rows and frames written so far that the output schedule asked for: a run's last step
+  // has a row and a frame even when none is due, which a restarted run must not keep.
+  void mark_rows_on_schedule() { rows_on_schedule_ = series_->rows(); }
+  void mark_frames_on_schedule() { frames_on_schedule_ = fields_ ? fields_->frames() : 0; }
+
+  // Those rows and the frames' index, for the checkpoint.
+  void save_state(StateArchive& archive) const {
+    std::string columns;
+    for (const auto& c : series_->columns()) columns += c + ",";
+    archive.put_text("run/series_columns", columns);
+    std::vector<double> rows;
+    for (std::size_t r = 0; r < rows_on_schedule_; ++r) rows.insert(rows.end(), series_->row(r).begin(), series_->row(r).end());
+    archive.put("run/series", rows);
+    archive.put("run/frames", static_cast<std::int64_t>(frames_on_schedule_));
+    archive.put_text("run/frames_index", fields_ ? fields_->frames_index(frames_on_schedule_) : "");
   }
 
   // One row of series.csv; returns the sensors' values.
@@ -224,7 +263,32 @@ class Outputs {
     breaks_last_write_ = now;
   }
 
+  void restore_rows(const StateArchive& restart) {
+    std::string columns;
+    for (const auto& c : series_->columns()) columns += c + ",";
+    if (restart.text("run/series_columns") != columns)
+      throw StateMismatch("its series.csv has the columns '" + restart.text("run/series_columns") + "', this scene '" + columns + "'");
+    const auto rows = restart.get<double>("run/series");
+    const std::size_t width = series_->columns().size();
+    if (rows.size() % width != 0) throw StateMismatch("its series rows are not whole rows");
+    for (std::size_t at = 0; at < rows.size(); at += width) series_->append(std::span<const double>(rows).subspan(at, width));
+    rows_on_schedule_ = series_->rows();
+  }
+
+  void carry_frames(const StateArchive& restart, const std::filesystem::path& dir) {
+    const auto frames = static_cast<std::size_t>(restart.integer("run/frames"));
+    if (frames == 0) return;
+    try {
+      fields_->carry_frames(earlier_fields_file(dir), frames, restart.text("run/frames_index"));
+      frames_on_schedule_ = frames;
+    } catch (const RunError& e) {
+      std::fprintf(stderr, "  warning: the %zu frames before the restart are not carried over (%s); fields.xdmf holds the frames from the restart on\n",
+                   frames, e.what());
+    }
+  }
+
   const Scene& scene_;
+  std::size_t rows_on_schedule_ = 0, frames_on_schedule_ = 0;
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
@@ -240,12 +304,12 @@ class Outputs {
 // says once, after 2 s, how long it will take: a time.end of 1e10 steps is not a silent hang.
 class Progress {
  public:
-  Progress(bool enabled, bool announce, long total)
-      : enabled_(enabled), announce_(announce && !enabled), total_(total), start_(Clock::now()), last_(start_) {}
+  Progress(bool enabled, bool announce, long first, long total)
+      : enabled_(enabled), announce_(announce && !enabled), first_(first), total_(total), start_(Clock::now()), last_(start_) {}
   void update(long step, double t) {
     if (announce_ && seconds_since(start_) > 2.0) {
       announce_ = false;
-      const double rate = step / seconds_since(start_), left = (total_ - step) / std::max(rate, 1e-9);
+      const double rate = (step - first_) / seconds_since(start_), left = (total_ - step) / std::max(rate, 1e-9);
       if (left > 60.0)
         std::fprintf(stderr, "  run time: about %.3g %s to go at %.0f steps/s (%ld of %ld steps done)\n",
                      left < 3600.0 ? left / 60.0 : left / 3600.0, left < 3600.0 ? "min" : "h", rate, step, total_);
@@ -253,7 +317,7 @@ class Progress {
     if (!enabled_ || seconds_since(last_) < 0.5) return;
     last_ = Clock::now();
     const double elapsed = seconds_since(start_);
-    const double rate = step / std::max(elapsed, 1e-9);
+    const double rate = (step - first_) / std::max(elapsed, 1e-9);
     std::fprintf(stderr, "\r  step %ld/%ld  t = %.4e s  %.0f steps/s  ETA %.0f s   ", step, total_, t, rate,
                  (total_ - step) / std::max(rate, 1e-9));
     std::fflush(stderr);
@@ -264,7 +328,7 @@ class Progress {
 
  private:
   bool enabled_, announce_;
-  long total_;
+  long first_, total_;  // steps: the run's first (0, or the restart's), its last
   Clock::time_point start_, last_;
 };
 
@@ -354,10 +418,20 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const bool static_only = scene.static_only();  // one solve, whatever --steps says
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
-  Outputs outputs(scene);
-  Progress progress(options.show_progress, options.announce_run_time, total_steps);
+  const StateArchive* restart = options.restart;
+  if (restart) {
+    check_same_run(*restart, scene, options.restart_file);
+    load_scene_state(scene, *restart, options.restart_file);
+  }
+  std::optional<Outputs> outputs_or;
+  try {
+    outputs_or.emplace(scene, restart, options.restart_file.parent_path());
+  } catch (const StateMismatch& e) {
+    throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
+  }
+  Outputs& outputs = *outputs_or;
   RunResult result;
-  const double initial_total = scene.model->energies().total() - continuum_balance_terms(scene).second;
+  double initial_total = scene.model->energies().total() - continuum_balance_terms(scene).second;
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
   // the motion that boundary conditions impose. A scene at rest has round-off forces (a bond's
@@ -370,9 +444,50 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   double energy_scale = std::abs(initial_total);
   const double round_off = model.round_off_kinetic_energy(scene.dt_critical);
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
+  const double checkpoint_every = scene.output.checkpoint_every;
+  double next_checkpoint = checkpoint_every;
   // Float steps accumulate round-off: an output is due within a millionth of a step.
   const double slack = 1e-6 * scene.dt;
   long steps_done = 0;
+  // The runner's part of the checkpoint: where the run is, its output schedule, the scales its
+  // checks use, and what it has reported; the rows and frames are the outputs'.
+  const auto save_checkpoint = [&] {
+    StateArchive archive;
+    put_run_identity(archive, scene);
+    scene.model->save_state(archive);
+    archive.put("run/steps_done", std::int64_t{steps_done});
+    for (const auto& [name, value] : {std::pair{"next_row", next_row}, {"next_frame", next_frame}, {"initial_total", initial_total}, {"energy_scale", energy_scale}})
+      archive.put("run/" + std::string(name), value);
+    std::vector<double> sensors;
+    for (const auto& [name, value] : result.sensors) sensors.push_back(value);
+    archive.put("run/sensors", sensors);
+    archive.put_text("run/damage_in_overlap", result.damage_in_overlap);
+    archive.put("run/damage_in_overlap_breaks", static_cast<std::int64_t>(result.damage_in_overlap_breaks));
+    outputs.save_state(archive);
+    write_state_file(scene.output.dir / checkpoint_file_name, archive);
+  };
+  if (restart) {
+    try {
+      steps_done = restart->integer("run/steps_done");
+      next_row = restart->number("run/next_row");
+      next_frame = restart->number("run/next_frame");
+      next_checkpoint = steps_done * scene.dt + checkpoint_every;  // the case's interval, from here
+      initial_total = restart->number("run/initial_total");
+      energy_scale = restart->number("run/energy_scale");
+      const auto names = series_columns(scene);
+      const auto sensors = restart->get<double>("run/sensors");
+      for (std::size_t k = 0; k < sensors.size() && k + 2 < names.size(); ++k) result.sensors.emplace_back(names[k + 2], sensors[k]);
+      result.damage_in_overlap = restart->text("run/damage_in_overlap");
+      result.damage_in_overlap_breaks = static_cast<std::size_t>(restart->integer("run/damage_in_overlap_breaks"));
+    } catch (const StateMismatch& e) {
+      throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
+    }
+    if (steps_done > scene.steps)
+      throw InputError("'" + options.restart_file.string() + "' is at step " + std::to_string(steps_done) + ", past this case's last step " +
+                       std::to_string(scene.steps) + " (time.end " + std::to_string(scene.end_time) + " s)");
+  }
+  const long first_step = steps_done;
+  Progress progress(options.show_progress, options.announce_run_time, first_step, total_steps);
   const auto current_time = [&] { return steps_done * scene.dt; };
   // Outputs are written after step n when it ends on a row or a frame, or is the last.
   const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
@@ -380,17 +495,20 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     const auto t0 = Clock::now();
     // A row takes every model's energies (the continuum's strain energy is a pass over it); a
     // frame alone needs only the DEM's, for the summary.
-    const bool row = current_time() + slack >= next_row || steps_done == total_steps;
-    const SceneEnergies energies = row ? scene.model->energies() : SceneEnergies{model.energies()};
+    // The last step has both whether due or not; only a due one moves the schedule on, so a
+    // run stopped early (--steps) and restarted keeps the schedule of the uninterrupted run.
+    const bool row_due = current_time() + slack >= next_row, frame_due = current_time() + slack >= next_frame;
+    const bool last = steps_done == total_steps;
+    const SceneEnergies energies = row_due || last ? scene.model->energies() : SceneEnergies{model.energies()};
     result.energies = energies.dem;
-    if (row) {
+    if (row_due || last) {
       result.sensors = outputs.write_row(current_time(), steps_done, energies, initial_total);
-      next_row += scene.output.every;
+      if (row_due) next_row += scene.output.every, outputs.mark_rows_on_schedule();
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
     }
-    if (current_time() + slack >= next_frame || steps_done == total_steps) {
+    if (frame_due || last) {
       outputs.write_fields(current_time());
-      next_frame += scene.output.fields_every;
+      if (frame_due) next_frame += scene.output.fields_every, outputs.mark_frames_on_schedule();
     }
     output_seconds += seconds_since(t0);
   };
@@ -408,8 +526,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       scene.continuum->solve_static();  // a static continuum alone: one solve, one output
       total_steps = 0;
     }
-    write_outputs();
-    for (long n = 1; n <= total_steps; ++n) {
+    if (!restart) write_outputs();
+    for (long n = first_step + 1; n <= total_steps; ++n) {
       if (const int signal = take_interrupt()) throw interruption(signal);
       if (output_after(n)) model.record_energies_in_next_step();  // the step's force pass gives the row's bond energies
       scene.model->step(scene.dt);
@@ -430,6 +548,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
                                     std::abs(model.external_work())) +
                            1e-300);
       if (output_after(n)) write_outputs();
+      if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {
+        save_checkpoint();
+        while (next_checkpoint <= current_time() + slack) next_checkpoint += checkpoint_every;
+      }
       progress.update(n, current_time());
       if (!result.stop_reason.empty()) break;
     }
@@ -438,6 +560,15 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   } catch (const Interrupted& e) {
     failure = e.what();
     interrupted = std::current_exception();
+  }
+  // The state at the end, or where a signal stopped the run: between two steps, so whole.
+  std::string checkpoint_error;
+  if (!static_only && (interrupted || (failure.empty() && checkpoint_every > 0.0))) {
+    try {
+      save_checkpoint();
+    } catch (const RunError& e) {
+      checkpoint_error = e.what();
+    }
   }
   progress.finish();
   result.steps = steps_done;
@@ -453,6 +584,11 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   summary["version"] = ARLEQUIN_VERSION;
   summary["status"] = failure.empty() ? "completed" : interrupted ? "interrupted" : "failed";
   if (!failure.empty()) summary["error"] = failure;
+  if (restart) {
+    summary["restarted_from"] = std::filesystem::absolute(options.restart_file).string();
+    summary["restarted_at_step"] = first_step;
+  }
+  if (!checkpoint_error.empty()) summary["checkpoint_error"] = checkpoint_error;
   if (!result.stop_reason.empty()) summary["stopped_early"] = result.stop_reason;
   if (!result.damage_in_overlap.empty()) {
     summary["damage_in_overlap"] = result.damage_in_overlap;

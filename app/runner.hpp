@@ -7,6 +7,9 @@
 // SIGINT or SIGTERM during the time loop ends it the same way, with status "interrupted", and
 // throws Interrupted (common/interrupt.hpp), which no RunError handler catches; one that comes
 // after the last step lets the run complete (status "completed") and then throws Interrupted.
+// Checkpoints (docs/restart.md): output.checkpoint_every writes checkpoint.h5 in the output folder
+// at that interval of simulated time and when the run ends; a SIGINT or SIGTERM writes one
+// before the outputs close, whatever the case says; a failed run writes none (its last one stays).
 #pragma once
 #include <algorithm>
 #include <functional>
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "app/scene.hpp"
+#include "common/state_archive.hpp"
 
 namespace arlequin::app {
 
@@ -27,6 +31,12 @@ struct RunOptions {
   // non-empty answer ends the run there as completed, with that reason in the summary
   // (e.g. a test to failure once the sample has broken).
   std::function<std::string(const std::vector<std::pair<std::string, double>>&)> stop_after_row;
+  // --restart FILE: the checkpoint read from `restart_file` (common/state_file.hpp). The run checks
+  // it is of this scene (app/checkpoint.hpp), takes its state and continues from its step,
+  // appending to the series and the breaks and extending the fields (their frames come from the
+  // fields.h5 beside the checkpoint).
+  const StateArchive* restart = nullptr;
+  std::filesystem::path restart_file;
 };
 
 struct RunResult {

@@ -82,6 +82,7 @@ struct OutputPlan {
   std::filesystem::path dir;
   double every = 0.0;         // s, series.csv rows
   double fields_every = 0.0;  // s, HDF5 frames
+  double checkpoint_every = 0.0;  // s, checkpoint.h5 (0: only when a signal stops the run)
   bool particle_fields = false;
   bool bond_fields = false;
   bool continuum_fields = false;

@@ -28,6 +28,14 @@ class Uncoupled final : public SceneModel {
     return {dem_.energies(), continuum_->kinetic_energy(), continuum_->strain_energy()};
   }
   std::optional<CouplingMonitorValues> monitor() const override { return std::nullopt; }
+  void save_state(StateArchive& archive) const override {
+    dem_.save_state(archive);
+    if (continuum_) continuum_->save_state(archive);
+  }
+  void load_state(const StateArchive& archive) override {
+    dem_.load_state(archive);
+    if (continuum_) continuum_->load_state(archive);
+  }
   void write_fields(FieldsWriter& fields, const OutputPlan& plan) const override {
     if (continuum_) continuum_->write_fields(fields);
     write_dem_fields(dem_, fields, plan);

@@ -9,6 +9,7 @@
 
 #include "common/fields_writer.hpp"
 #include "common/json.hpp"
+#include "common/state_archive.hpp"
 #include "dem/dem_model.hpp"
 
 namespace arlequin::app {
@@ -51,6 +52,10 @@ class SceneModel {
   virtual std::optional<OverlapDamageReport> damage_in_overlap() { return std::nullopt; }
   // The frame's fields: particles (and bonds, as the plan asks) and the continuum's.
   virtual void write_fields(FieldsWriter& fields, const OutputPlan& plan) const = 0;
+  // Checkpoint (app/checkpoint.hpp): every state a step carries to the next, of every model it
+  // holds; load_state on the model built again from the same case (StateMismatch if it is not).
+  virtual void save_state(StateArchive& archive) const = 0;
+  virtual void load_state(const StateArchive& archive) = 0;
   virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)
   virtual void describe(Json& counts) const {}       // summary.json counts of its own
 };

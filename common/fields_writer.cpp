@@ -84,6 +84,14 @@ std::string number_text(double value) {
   return std::string(buffer, std::to_chars(buffer, buffer + sizeof buffer, value).ptr);
 }
 
+void replace_all(std::string& text, const std::string& from, const std::string& to) {
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+}
+
+// Stands for the HDF5 file's name in frames_index(): a control character, which no XML holds.
+constexpr const char* file_token = "\x1f:";
+
 void check_name(std::string_view kind, const std::string& name) {
   if (name.empty() || name.find('/') != std::string::npos)
     throw std::logic_error("FieldsWriter: bad " + std::string(kind) + " name '" + name + "'");
@@ -170,10 +178,40 @@ void FieldsWriter::close() {
   std::filesystem::rename(part_path_, h5_path_, ec);
   if (ec) throw RunError("cannot rename '" + part_path_.string() + "' to '" + h5_path_.string() + "': " + ec.message());
   // The frames now name the renamed file ("<file>:" starts every dataset reference).
-  const std::string from = h5_reference_ + ":", to = reference_to(h5_path_) + ":";
-  for (std::size_t at = frames_xml_.find(from); at != std::string::npos; at = frames_xml_.find(from, at + to.size()))
-    frames_xml_.replace(at, from.size(), to);
+  replace_all(frames_xml_, h5_reference_ + ":", reference_to(h5_path_) + ":");
   h5_reference_ = reference_to(h5_path_);
+  write_xdmf();
+}
+
+std::string FieldsWriter::frames_index(std::size_t frames) const {
+  // Each frame's XDMF starts with its collection grid (finish_frame).
+  std::size_t end = 0;
+  for (std::size_t k = 0; k <= frames && end != std::string::npos; ++k)
+    end = frames_xml_.find("<Grid Name=\"frame_", k == 0 ? 0 : end + 1);
+  std::string index = frames_xml_.substr(0, end);
+  replace_all(index, h5_reference_ + ":", file_token);
+  return index;
+}
+
+void FieldsWriter::carry_frames(const std::filesystem::path& earlier, std::size_t frames, const std::string& index) {
+  if (file_ < 0 || in_frame_ || frame_count_ > 0) throw std::logic_error("FieldsWriter::carry_frames: only before the first frame");
+  if (frames == 0) return;
+  if (H5Fis_hdf5(earlier.c_str()) <= 0) throw RunError("'" + earlier.string() + "' is not a readable HDF5 file");
+  const Handle source(checked(H5Fopen(earlier.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), earlier, "open", "file"), H5Fclose);
+  for (std::size_t k = 0; k < frames; ++k) {
+    char path[32];
+    std::snprintf(path, sizeof path, "/frames/%06zu", k);
+    if (H5Lexists(source, "/frames", H5P_DEFAULT) <= 0 || H5Lexists(source, path, H5P_DEFAULT) <= 0) {
+      // Leave the file as it was: no frame carried.
+      if (k > 0) checked(H5Ldelete(file_, "/frames", H5P_DEFAULT), part_path_, "remove", "/frames");
+      throw RunError("'" + earlier.string() + "' has no frame " + std::to_string(k) + " (" + std::to_string(frames) + " expected)");
+    }
+    checked(H5Ocopy(source, path, file_, path, H5P_DEFAULT, intermediate_groups(part_path_, path)), part_path_, "copy", path);
+  }
+  frames_xml_ = index;
+  replace_all(frames_xml_, file_token, h5_reference_ + ":");
+  frame_count_ = frames;
+  checked(H5Fflush(file_, H5F_SCOPE_LOCAL), part_path_, "flush", "file");
   write_xdmf();
 }
 

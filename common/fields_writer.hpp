@@ -71,6 +71,14 @@ class FieldsWriter {
 
   std::size_t frames() const { return frame_count_; }
 
+  // Restart (app/checkpoint.hpp). frames_index(): the XDMF of the first `frames` finished frames
+  // with the HDF5 file's name left out. carry_frames(): copies frames [0, frames) of `earlier` (a file this class
+  // wrote) into this writer's file and takes `index` (frames_index() of the writer that wrote
+  // them) as their XDMF, so the frames go on from there; only before the first frame. RunError
+  // when `earlier` cannot be read or lacks one of those frames (then nothing was carried).
+  std::string frames_index(std::size_t frames) const;
+  void carry_frames(const std::filesystem::path& earlier, std::size_t frames, const std::string& index);
+
  private:
   struct Column;  // typed view of values to store (defined in the .cpp)
   struct Grid {

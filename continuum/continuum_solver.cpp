@@ -393,6 +393,25 @@ void ContinuumSolver::step(double dt) {
   if (!std::isfinite(sum)) throw RunError("continuum: non-finite state at t = " + std::to_string(t_));
 }
 
+void ContinuumSolver::save_state(StateArchive& archive, const std::string& prefix) const {
+  archive.put(prefix + "lumped_mass", mass_);
+  archive.put(prefix + "u", u_);
+  archive.put(prefix + "v", v_);
+  archive.put(prefix + "f", f_);
+  archive.put(prefix + "time", t_);
+  archive.put(prefix + "external_work", external_work_);
+}
+
+void ContinuumSolver::load_state(const StateArchive& archive, const std::string& prefix) {
+  if (archive.get<double>(prefix + "lumped_mass") != mass_)
+    throw StateMismatch("its continuum's lumped mass differs from this scene's (another mesh, material or weight)");
+  archive.get_into(prefix + "u", u_);
+  archive.get_into(prefix + "v", v_);
+  archive.get_into(prefix + "f", f_);
+  t_ = archive.number(prefix + "time");
+  external_work_ = archive.number(prefix + "external_work");
+}
+
 double ContinuumSolver::verlet_correction(double dt) const {
   double sum = 0.0;
   for (std::size_t d = 0; d < f_.size(); ++d)

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "common/state_archive.hpp"
 #include "common/vec3.hpp"
 #include "continuum/block_matrix.hpp"
 #include "continuum/material.hpp"
@@ -128,6 +129,11 @@ class ContinuumSolver {
   // work, kinetic + strain energy minus this (the step's shadow energy of a linear system).
   double verlet_correction(double dt) const;
 
+  // Checkpoint (docs/restart.md): u, v, f, time and the external work under `prefix`, with the
+  // lumped mass to recognise the discretisation; load_state on the solver built again from the
+  // same case (weighted alike) continues bit for bit, StateMismatch if the mass differs.
+  void save_state(StateArchive& archive, const std::string& prefix) const;
+  void load_state(const StateArchive& archive, const std::string& prefix);
   // Static equilibrium at the current time; leaves u solved, v untouched, forces updated.
   void solve_static(const std::string& petsc_options = "");
   // SettingError at "petsc_options" when PETSc refuses the static solve's options or leaves one

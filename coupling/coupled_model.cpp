@@ -293,6 +293,44 @@ double CoupledModel::displacement_residual() const {
   return scale > 0 ? r / scale : r;
 }
 
+namespace {
+// Rows of a Matrix3 (one per DE or node, row-major) as 3-vectors, for the checkpoint.
+std::span<const Vec3> rows_of(const Matrix3& m) { return {reinterpret_cast<const Vec3*>(m.data()), static_cast<std::size_t>(m.rows())}; }
+std::span<Vec3> rows_of(Matrix3& m) { return {reinterpret_cast<Vec3*>(m.data()), static_cast<std::size_t>(m.rows())}; }
+}  // namespace
+
+void CoupledModel::save_state(StateArchive& archive) const {
+  dem_.save_state(archive);
+  continuum_.save_state(archive, "continuum/");
+  archive.put("coupling/mu", rows_of(mu_));
+  archive.put("coupling/acceleration_dem", rows_of(acc_d_));
+  archive.put("coupling/acceleration_continuum", rows_of(acc_c_));
+  archive.put("coupling/drift_residual", rows_of(drift_residual_));
+  archive.put("coupling/work", coupling_work_);
+  archive.put("coupling/time", time_);
+  archive.put("coupling/steps", std::int64_t{steps_});
+  archive.put("coupling/breaks_looked_at", static_cast<std::int64_t>(breaks_looked_at_));
+}
+
+void CoupledModel::load_state(const StateArchive& archive) {
+  dem_.load_state(archive);
+  continuum_.load_state(archive, "continuum/");
+  archive.get_into("coupling/mu", rows_of(mu_));
+  archive.get_into("coupling/acceleration_dem", rows_of(acc_d_));
+  archive.get_into("coupling/acceleration_continuum", rows_of(acc_c_));
+  // Empty before the first step (a checkpoint at step 0), one row per constraint after.
+  const auto drift = archive.get<Vec3>("coupling/drift_residual");
+  if (!drift.empty() && drift.size() != static_cast<std::size_t>(mu_.rows()))
+    throw StateMismatch("'coupling/drift_residual' holds " + std::to_string(drift.size()) + " rows, this coupling has " +
+                        std::to_string(mu_.rows()) + " constraints");
+  drift_residual_.resize(static_cast<Eigen::Index>(drift.size()), 3);
+  std::copy(drift.begin(), drift.end(), rows_of(drift_residual_).begin());
+  coupling_work_ = archive.number("coupling/work");
+  time_ = archive.number("coupling/time");
+  steps_ = archive.integer("coupling/steps");
+  breaks_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/breaks_looked_at"));
+}
+
 Matrix3 CoupledModel::dem_coupling_force() const { return -(ops_.Gd.transpose() * mu_); }
 Matrix3 CoupledModel::continuum_coupling_force() const { return -(ops_.Gc.transpose() * mu_); }
 

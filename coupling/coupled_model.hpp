@@ -162,6 +162,14 @@ class CoupledModel {
   // first; nullopt if none): each break of the DEM is looked at once.
   std::optional<OverlapDamage> damage_in_overlap();
 
+  // Checkpoint (docs/restart.md): both models' states (DemModel::save_state,
+  // ContinuumSolver::save_state under "continuum/") and the coupling's own under "coupling/": the
+  // multipliers and constraint accelerations the next step's first half kick applies, the
+  // drift residual, the multiplier work, time, step and the breaks already looked at. load_state
+  // on the coupled model built again from the same case continues bit for bit.
+  void save_state(StateArchive& archive) const;
+  void load_state(const StateArchive& archive);
+
   const OverlapZone& zone() const { return zone_; }
   const CouplingOperators& operators() const { return ops_; }
   const MultiplierSolver& multipliers() const { return *solver_; }

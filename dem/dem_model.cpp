@@ -532,4 +532,89 @@ void DemModel::check_energy(double energy_limit) const {
   throw RunError(msg.str());
 }
 
+void DemModel::save_state(StateArchive& archive) const {
+  const ParticleSet& p = particles;
+  for (const auto& [name, values] : {std::pair{"reference", &p.reference}, {"position", &p.position}, {"velocity", &p.velocity},
+                                     {"angular_velocity", &p.angular_velocity}, {"force", &p.force}, {"torque", &p.torque}})
+    archive.put("dem/particles/" + std::string(name), *values);
+  archive.put("dem/particles/orientation", p.orientation);
+  archive.put("dem/particles/radius", p.radius);
+  archive.put("dem/particles/inv_mass", p.inv_mass);
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) bond_sets_[s]->save_state(archive, "dem/bonds/" + std::to_string(s) + "/");
+  if (neighbours_) neighbours_->save_state(archive, "dem/neighbours/");
+  std::vector<double> time, stress, energy, mode_mix;
+  std::vector<std::uint32_t> set, bond, criterion, mode;
+  for (const BreakEvent& e : breaks_) {
+    time.push_back(e.time), stress.push_back(e.stress), energy.push_back(e.energy), mode_mix.push_back(e.mode_mix);
+    set.push_back(e.set), bond.push_back(e.bond);
+    criterion.push_back(static_cast<std::uint32_t>(e.criterion)), mode.push_back(static_cast<std::uint32_t>(e.mode));
+  }
+  for (const auto& [name, values] : {std::pair{"time", &time}, {"stress", &stress}, {"energy", &energy}, {"mode_mix", &mode_mix}})
+    archive.put("dem/breaks/" + std::string(name), *values);
+  for (const auto& [name, values] : {std::pair{"set", &set}, {"bond", &bond}, {"criterion", &criterion}, {"mode", &mode}})
+    archive.put("dem/breaks/" + std::string(name), *values);
+  archive.put("dem/constraint_reaction", constraint_reaction_);
+  archive.put("dem/damping_force", damping_force_);
+  archive.put("dem/damping_torque", damping_torque_);
+  archive.put("dem/reaction", std::span<const Vec3>(reaction_));
+  archive.put("dem/time", time_);
+  archive.put("dem/last_dt", last_dt_);
+  archive.put("dem/steps", std::int64_t{steps_});
+  archive.put("dem/external_work", external_work_);
+  archive.put("dem/dissipated", dissipated_);
+  archive.put("dem/fracture", fracture_);
+  archive.put("dem/energy_record_requested", std::int64_t{energy_record_requested_});
+  archive.put("dem/energy_record_step", std::int64_t{energy_record_step_});
+}
+
+void DemModel::load_state(const StateArchive& archive) {
+  ParticleSet& p = particles;
+  // The scene must be the one the checkpoint left: same DEs, to the bit.
+  for (const auto& [name, values] : {std::pair{"radius", &p.radius}, {"inv_mass", &p.inv_mass}})
+    if (archive.get<double>("dem/particles/" + std::string(name)) != *values)
+      throw StateMismatch("its DEs' " + std::string(name) + " differ from this scene's");
+  if (archive.get<Vec3>("dem/particles/reference") != p.reference)
+    throw StateMismatch("its DEs' reference positions differ from this scene's");
+  for (const auto& [name, values] : {std::pair{"position", &p.position}, {"velocity", &p.velocity},
+                                     {"angular_velocity", &p.angular_velocity}, {"force", &p.force}, {"torque", &p.torque}})
+    archive.get_into("dem/particles/" + std::string(name), *values);
+  archive.get_into("dem/particles/orientation", p.orientation);
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) bond_sets_[s]->load_state(archive, "dem/bonds/" + std::to_string(s) + "/");
+  if (archive.has("dem/bonds/" + std::to_string(bond_sets_.size()) + "/first"))
+    throw StateMismatch("it has more bond sets than this scene's " + std::to_string(bond_sets_.size()));
+  if (neighbours_) {
+    neighbours_->set_exclusions(intact_bonded_pairs());
+    neighbours_->load_state(archive, "dem/neighbours/");
+    for (const auto& [i, j] : neighbours_->pairs())
+      if (i >= p.size() || j >= p.size()) throw StateMismatch("its contact pairs name DEs beyond this scene's");
+  }
+  const auto time = archive.get<double>("dem/breaks/time"), stress = archive.get<double>("dem/breaks/stress"),
+             energy = archive.get<double>("dem/breaks/energy"), mode_mix = archive.get<double>("dem/breaks/mode_mix");
+  const auto set = archive.get<std::uint32_t>("dem/breaks/set"), bond = archive.get<std::uint32_t>("dem/breaks/bond"),
+             criterion = archive.get<std::uint32_t>("dem/breaks/criterion"), mode = archive.get<std::uint32_t>("dem/breaks/mode");
+  const std::size_t n = time.size();
+  for (const std::size_t size : {stress.size(), energy.size(), mode_mix.size(), set.size(), bond.size(), criterion.size(), mode.size()})
+    if (size != n) throw StateMismatch("its break records have columns of different lengths");
+  breaks_.clear();
+  for (std::size_t k = 0; k < n; ++k) {
+    if (set[k] >= bond_sets_.size() || bond[k] >= bond_sets_[set[k]]->size() || !bond_sets_[set[k]]->broken()[bond[k]] ||
+        criterion[k] > static_cast<std::uint32_t>(FailureCriterion::cohesive) || mode[k] > static_cast<std::uint32_t>(FailureMode::torsion))
+      throw StateMismatch("its break record " + std::to_string(k) + " names a bond this scene does not have broken");
+    breaks_.push_back({time[k], set[k], bond[k], static_cast<FailureCriterion>(criterion[k]), static_cast<FailureMode>(mode[k]),
+                       stress[k], energy[k], mode_mix[k]});
+  }
+  archive.get_into("dem/constraint_reaction", constraint_reaction_);
+  archive.get_into("dem/damping_force", damping_force_);
+  archive.get_into("dem/damping_torque", damping_torque_);
+  archive.get_into("dem/reaction", std::span<Vec3>(reaction_));
+  time_ = archive.number("dem/time");
+  last_dt_ = archive.number("dem/last_dt");
+  steps_ = archive.integer("dem/steps");
+  external_work_ = archive.number("dem/external_work");
+  dissipated_ = archive.number("dem/dissipated");
+  fracture_ = archive.number("dem/fracture");
+  energy_record_requested_ = archive.integer("dem/energy_record_requested") != 0;
+  energy_record_step_ = archive.integer("dem/energy_record_step");
+}
+
 }  // namespace arlequin::dem

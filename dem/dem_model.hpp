@@ -123,6 +123,14 @@ class DemModel {
   // step dt_c it is the scale of round-off motion (app/runner.cpp).
   double round_off_kinetic_energy(double time) const;
 
+  // Checkpoint (docs/restart.md): everything the next step reads of what the earlier ones left,
+  // under "dem/": the DEs' motion and last forces, each bond set's history, the neighbour list,
+  // the break records, the running energy sums, time and step. load_state() on the model built
+  // again from the same case and finalized continues bit for bit; StateMismatch when the
+  // checkpoint's DEs (radius, mass, reference position) or bonds are not this model's.
+  void save_state(StateArchive& archive) const;
+  void load_state(const StateArchive& archive);
+
  private:
   template <class Value>
   Vec3 group_mean(int group, Value value) const;

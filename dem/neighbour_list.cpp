@@ -87,4 +87,16 @@ bool NeighbourList::needs_rebuild(const ParticleSet& p) const {
   return false;
 }
 
+void NeighbourList::save_state(StateArchive& archive, const std::string& prefix) const {
+  archive.put(prefix + "pairs", pairs_);
+  archive.put(prefix + "position_at_build", position_at_build_);
+  archive.put(prefix + "builds", static_cast<std::int64_t>(builds_));
+}
+
+void NeighbourList::load_state(const StateArchive& archive, const std::string& prefix) {
+  pairs_ = archive.get<std::pair<std::uint32_t, std::uint32_t>>(prefix + "pairs");
+  position_at_build_ = archive.get<Vec3>(prefix + "position_at_build");
+  builds_ = static_cast<std::size_t>(archive.integer(prefix + "builds"));
+}
+
 }  // namespace arlequin::dem

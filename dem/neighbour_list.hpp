@@ -7,9 +7,11 @@
 #pragma once
 #include <cstdint>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "common/state_archive.hpp"
 #include "dem/particles.hpp"
 
 namespace arlequin::dem {
@@ -25,6 +27,11 @@ class NeighbourList {
   std::span<const std::pair<std::uint32_t, std::uint32_t>> pairs() const { return pairs_; }
   std::size_t builds() const { return builds_; }
   double skin() const { return skin_; }
+  // Checkpoint: the list and the positions it was built at (so the restarted run rebuilds when
+  // the uninterrupted one would, with the pairs in the same order), under `prefix`. The
+  // exclusions are the caller's to set again.
+  void save_state(StateArchive& archive, const std::string& prefix) const;
+  void load_state(const StateArchive& archive, const std::string& prefix);
 
  private:
   double skin_;

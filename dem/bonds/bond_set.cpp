@@ -70,4 +70,24 @@ void BondSet::add_recorded_energy_per_particle(std::span<double> energy) const {
   }
 }
 
+void BondSet::save_state(StateArchive& archive, const std::string& prefix) const {
+  archive.put(prefix + "first", first_);
+  archive.put(prefix + "second", second_);
+  archive.put(prefix + "broken", broken_);
+  archive.put(prefix + "energy_record", energy_record_);
+  save_law_state(archive, prefix);
+}
+
+void BondSet::load_state(const StateArchive& archive, const std::string& prefix) {
+  if (archive.get<std::uint32_t>(prefix + "first") != first_ || archive.get<std::uint32_t>(prefix + "second") != second_)
+    throw StateMismatch("the bonds of '" + prefix + "' join other DEs than this scene's");
+  std::vector<std::uint8_t> broken(size());
+  archive.get_into(prefix + "broken", broken);
+  for (std::size_t b = 0; b < size(); ++b)
+    if (broken[b] && !broken_[b]) break_bond(b);
+  if (broken != broken_) throw StateMismatch("'" + prefix + "broken' has a bond intact that this scene starts broken");
+  archive.get_into(prefix + "energy_record", energy_record_);
+  load_law_state(archive, prefix);
+}
+
 }  // namespace arlequin::dem

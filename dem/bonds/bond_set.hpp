@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common/parallel.hpp"
+#include "common/state_archive.hpp"
 #include "common/schema.hpp"
 #include "dem/failure.hpp"
 #include "dem/particles.hpp"
@@ -149,6 +150,12 @@ class BondSet {
     energy_record_[b] = 0.0;
   }
   std::span<const std::uint8_t> broken() const { return broken_; }
+  // Checkpoint: the pairs (to recognise the set), the broken flags, the energy record and the
+  // law's own history (save_law_state) under `prefix`. load_state on the set built again from the
+  // same case (finalized, weighted) breaks again the bonds that were broken; StateMismatch if the
+  // pairs differ.
+  void save_state(StateArchive& archive, const std::string& prefix) const;
+  void load_state(const StateArchive& archive, const std::string& prefix);
 
   std::size_t size() const { return first_.size(); }
   std::span<const std::uint32_t> first() const { return first_; }
@@ -183,6 +190,10 @@ class BondSet {
                    [&](long b) { energy_record_[b] = bond_energy(static_cast<std::size_t>(b)); });
   }
   virtual void zero_stiffness(std::size_t b) = 0;
+  // What the law's bonds remember beyond broken or intact (a cohesive link's damage): none by
+  // default.
+  virtual void save_law_state(StateArchive&, const std::string& /*prefix*/) const {}
+  virtual void load_law_state(const StateArchive&, const std::string& /*prefix*/) {}
 
   std::vector<std::uint32_t> first_, second_;
   std::vector<std::uint8_t> broken_;

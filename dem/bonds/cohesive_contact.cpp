@@ -183,6 +183,16 @@ void CohesiveContactSet::add_frequency_bound(std::size_t b, const ParticleSet& p
   }
 }
 
+void CohesiveContactSet::save_law_state(StateArchive& archive, const std::string& prefix) const {
+  archive.put(prefix + "damage", damage_);
+  archive.put(prefix + "dissipated", dissipated_);
+}
+
+void CohesiveContactSet::load_law_state(const StateArchive& archive, const std::string& prefix) {
+  archive.get_into(prefix + "damage", damage_);
+  archive.get_into(prefix + "dissipated", dissipated_);
+}
+
 std::string CohesiveContactSet::describe() const {
   std::size_t failed = 0;
   for (auto f : broken_) failed += f;

@@ -103,6 +103,9 @@ class CohesiveContactSet final : public BondKernelSet<CohesiveContactSet> {
   double section(std::size_t b) const { return section_[b]; }  // S of link b, m^2
 
  private:
+  void save_law_state(StateArchive& archive, const std::string& prefix) const override;
+  void load_law_state(const StateArchive& archive, const std::string& prefix) override;
+
   Parameters parameters_;
   double section_scale_ = 1.0;         // nominal area / sum of pi R^2 (1 without an area)
   std::vector<double> section_;        // S, m^2
