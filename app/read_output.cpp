@@ -319,7 +319,7 @@ void read_output(std::optional<CaseNode> out, Scene& scene) {
       (f == "particles" ? plan.particle_fields : f == "bonds" ? plan.bond_fields : plan.continuum_fields) = true;
     }
     plan.fields_every = out->number_or("fields_every", plan.every, Range::positive(), "s");
-    plan.checkpoint_every = out->number_or("checkpoint_every", 0.0, Range::positive(), "s");
+    if (out->has("checkpoint_every")) plan.checkpoint_every = out->number("checkpoint_every", Range::positive(), "s");
     for (CaseNode p : out->list_or_empty("plots")) {
       PlotPlan plot;
       plot.file = p.string("file");

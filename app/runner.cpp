@@ -421,6 +421,9 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const StateArchive* restart = options.restart;
   if (restart) {
     check_same_run(*restart, scene, options.restart_file);
+    if (const long at = restart_step(*restart, options.restart_file); at > scene.steps)
+      throw InputError("'" + options.restart_file.string() + "' is at step " + std::to_string(at) + ", past this case's last step " +
+                       std::to_string(scene.steps) + " (time.end " + std::to_string(scene.end_time) + " s)");
     load_scene_state(scene, *restart, options.restart_file);
   }
   std::optional<Outputs> outputs_or;
@@ -482,9 +485,6 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     } catch (const StateMismatch& e) {
       throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
     }
-    if (steps_done > scene.steps)
-      throw InputError("'" + options.restart_file.string() + "' is at step " + std::to_string(steps_done) + ", past this case's last step " +
-                       std::to_string(scene.steps) + " (time.end " + std::to_string(scene.end_time) + " s)");
   }
   const long first_step = steps_done;
   Progress progress(options.show_progress, options.announce_run_time, first_step, total_steps);

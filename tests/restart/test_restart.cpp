@@ -143,10 +143,13 @@ TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
   EXPECT_EQ(test::read_text(stopped / "breaks.csv"), test::read_text(whole / "breaks.csv"));
 }
 
-// Each refusal: exit 2, one line naming the file and the reason.
+// Each refusal: exit 2, one line naming the file and the reason, and no output written.
 void expect_refused(const std::string& args, const std::string& reason) {
-  const auto r = test::run_arlequin("run " + lattice + " --quiet --out " + test::scratch_path("restart_refused").string() + args);
+  const fs::path out = test::scratch_path("restart_refused");
+  fs::remove_all(out);
+  const auto r = test::run_arlequin("run " + lattice + " --quiet --out " + out.string() + args);
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(out / "series.csv")) << reason;
   EXPECT_NE(r.output.find(reason), std::string::npos) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
 }
@@ -155,6 +158,7 @@ TEST(RestartRefusal, AnotherCaseNamesTheKeyButTimeEndAndOutputMayChange) {
   const fs::path file = lattice_checkpoint("refusal_case");
   expect_refused(" --restart " + file.string() + " --set dem.damping=1.0e4", "is a checkpoint of another case: 'dem.damping' differs");
   expect_refused(" --restart " + file.string() + " --set dem.bond.sigma_f=1.9e8", "'dem.bond.sigma_f' differs");
+  expect_refused(" --restart " + file.string() + " --set time.end=3.0e-6", "is at step 200, past this case's last step 92");
   const auto r = test::run_arlequin("run " + lattice + " --quiet --out " + test::scratch_path("restart_refusal_case").string() +
                                     " --restart " + file.string() + " --steps 300 --set time.end=4.0e-4 --set output.every=4.0e-6");
   EXPECT_EQ(r.exit_code, 0) << r.output;
