@@ -155,6 +155,7 @@ class Outputs {
     if (fields_) fields_->close();
   }
   const CsvSeries& series() const { return *series_; }
+  std::size_t frames_carried() const { return frames_carried_; }
 
   // The case's plots of series.csv columns, drawn once the file is complete.
   void write_plots() const {
@@ -280,7 +281,7 @@ class Outputs {
     if (frames == 0) return;
     try {
       fields_->carry_frames(earlier_fields_file(dir), frames, restart.text("run/frames_index"));
-      frames_on_schedule_ = frames;
+      frames_on_schedule_ = frames_carried_ = frames;
     } catch (const RunError& e) {
       std::fprintf(stderr, "  warning: the %zu frames before the restart are not carried over (%s); fields.xdmf holds the frames from the restart on\n",
                    frames, e.what());
@@ -289,6 +290,7 @@ class Outputs {
 
   const Scene& scene_;
   std::size_t rows_on_schedule_ = 0, frames_on_schedule_ = 0;
+  std::size_t frames_carried_ = 0;  // frames copied from before a restart
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
@@ -587,6 +589,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   if (restart) {
     summary["restarted_from"] = std::filesystem::absolute(options.restart_file).string();
     summary["restarted_at_step"] = first_step;
+    summary["restart_frames_carried"] = outputs.frames_carried();
   }
   if (!checkpoint_error.empty()) summary["checkpoint_error"] = checkpoint_error;
   if (!result.stop_reason.empty()) summary["stopped_early"] = result.stop_reason;

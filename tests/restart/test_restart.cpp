@@ -42,9 +42,17 @@ long steps_of(const fs::path& dir) { return Json::parse(test::read_text(dir / "s
 
 class Restart : public ::testing::TestWithParam<RestartCase> {};
 
+std::size_t frames_in(const fs::path& xdmf) {
+  const std::string text = test::read_text(xdmf);
+  std::size_t n = 0;
+  for (std::size_t at = text.find("<Grid Name=\"frame_"); at != std::string::npos; at = text.find("<Grid Name=\"frame_", at + 1)) ++n;
+  return n;
+}
+
 TEST_P(Restart, HalfWayCheckpointContinuesToTheSameBits) {
   const RestartCase& c = GetParam();
-  const fs::path out = test::scratch_dir("restart_" + c.name), whole = out / "whole", split = out / "split", moved = out / "moved";
+  const fs::path out = test::scratch_dir("restart_" + c.name), whole = out / "whole", split = out / "split", moved = out / "moved",
+                 alone = out / "alone";
   const std::string run = "run " + source(c.case_file) + " --quiet";
   const auto r = test::run_arlequin(run + " --out " + whole.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -54,21 +62,31 @@ TEST_P(Restart, HalfWayCheckpointContinuesToTheSameBits) {
   const auto half = test::run_arlequin(run + " --out " + split.string() + " --steps " + std::to_string(steps / 2) +
                                        " --set output.checkpoint_every=1");
   ASSERT_EQ(half.exit_code, 0) << half.output;
-  ASSERT_TRUE(fs::exists(split / "checkpoint.h5"));
-  fs::copy_file(split / "checkpoint.h5", out / "checkpoint.h5");
-  // Into the same folder, and from a copy elsewhere into a new one (--out).
-  const auto again = test::run_arlequin(run + " --out " + split.string() + " --restart " + (split / "checkpoint.h5").string());
-  ASSERT_EQ(again.exit_code, 0) << again.output;
-  const auto elsewhere = test::run_arlequin(run + " --out " + moved.string() + " --restart " + (out / "checkpoint.h5").string());
+  const fs::path checkpoint = split / "checkpoint.h5";
+  ASSERT_TRUE(fs::exists(checkpoint));
+  fs::copy_file(checkpoint, out / "alone.h5");
+  // Into a new folder (--out; the frames so far come from the checkpoint's folder), then into
+  // the checkpoint's own folder.
+  const auto elsewhere = test::run_arlequin(run + " --out " + moved.string() + " --restart " + checkpoint.string());
   ASSERT_EQ(elsewhere.exit_code, 0) << elsewhere.output;
+  const auto again = test::run_arlequin(run + " --out " + split.string() + " --restart " + checkpoint.string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  // A checkpoint with no fields file beside it: the series are whole, the frames start at the restart.
+  const auto lonely = test::run_arlequin(run + " --out " + alone.string() + " --restart " + (out / "alone.h5").string());
+  ASSERT_EQ(lonely.exit_code, 0) << lonely.output;
   for (const char* file : {"series.csv", "breaks.csv", "fields.xdmf"}) {
     if (!fs::exists(whole / file)) continue;
     EXPECT_EQ(test::read_text(split / file), test::read_text(whole / file)) << c.name << ": " << file << " restarted in place";
-    // The frames before the restart stay in the folder of the checkpoint: a new folder's
-    // fields.xdmf starts at the restart, and names its own file.
+    EXPECT_EQ(test::read_text(moved / file), test::read_text(whole / file)) << c.name << ": " << file << " restarted elsewhere";
     if (std::string(file) != "fields.xdmf") {
-      EXPECT_EQ(test::read_text(moved / file), test::read_text(whole / file)) << c.name << ": " << file << " restarted elsewhere";
+      EXPECT_EQ(test::read_text(alone / file), test::read_text(whole / file)) << c.name << ": " << file << " without the fields";
     }
+  }
+  if (fs::exists(whole / "fields.xdmf")) {
+    const std::size_t carried = Json::parse(test::read_text(split / "summary.json"))["restart_frames_carried"].get<std::size_t>();
+    EXPECT_GT(carried, 0u);
+    EXPECT_EQ(frames_in(alone / "fields.xdmf"), frames_in(whole / "fields.xdmf") - carried);
+    EXPECT_NE(lonely.output.find("are not carried over"), std::string::npos) << lonely.output;
   }
   EXPECT_EQ(steps_of(split), steps);
   const Json summary = Json::parse(test::read_text(split / "summary.json"));
