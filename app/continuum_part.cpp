@@ -29,6 +29,8 @@ constexpr KeyDoc continuum_keys[] = {
     {"shape_functions", KeyType::choice, "", {}, "sibson", "nem: natural-neighbour interpolant", "sibson | laplace"},
     {"stabilization", KeyType::number, "1", Range::positive(), "1", "nem: weight of the SCNI stabilisation term"},
     {"petsc_options", KeyType::string, "", {}, "", "PETSc options of the static solve (e.g. -ksp_type cg -pc_type gamg)"},
+    {"damping", KeyType::number, "1/s", Range::non_negative(), "0",
+     "explicit: viscous damping, force -c m v on the free dofs (as dem.damping); it lowers the critical step"},
     {"boundary", KeyType::list, "", {}, "(none)", "boundary conditions on groups of mesh nodes"},
 };
 constexpr KeyDoc mesh_keys[] = {
@@ -128,6 +130,7 @@ struct ContinuumCaseSettings {
   std::string solver_name{};
   continuum::ContinuumSettings solver{};
   bool is_static = false;
+  double damping = 0.0;  // 1/s
   std::vector<ContinuumBoundary> boundaries{};
 };
 // What coupling: says; its overlap zone is built (and so checked) as it is read.
@@ -192,6 +195,8 @@ ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_
   out.solver.petsc_options = own_options + " " + extra_petsc_options;
   static constexpr std::string_view analyses[] = {"explicit", "static"};
   out.is_static = section.choice_or("analysis", "explicit", analyses) == "static";
+  out.damping = section.number_or("damping", 0.0, Range::non_negative(), "1/s");
+  if (out.is_static && out.damping > 0.0) section.fail("damping", "is for analysis: explicit (a static solve has no velocity)");
   // Options that nothing reads are an error, not silence: the explicit step solves nothing.
   const bool any_options = out.solver.petsc_options.find_first_not_of(' ') != std::string::npos;
   if (any_options && !out.is_static) {
@@ -295,7 +300,8 @@ class Coupled final : public SceneModel {
   }
   double critical_time_step() const override { return model_->critical_time_step(); }
   SceneEnergies energies() const override {
-    return {dem_.energies(), continuum_.kinetic_energy(), continuum_.strain_energy(), model_->coupling_work()};
+    return {dem_.energies(), continuum_.kinetic_energy(), continuum_.strain_energy(), model_->coupling_work(),
+            continuum_.dissipated()};
   }
   std::optional<CouplingMonitorValues> monitor() const override {
     const coupling::CouplingMonitor m = model_->monitor();
@@ -330,6 +336,7 @@ class Part final : public ContinuumPart {
     }
     try {
       solver_ = continuum::make_continuum_solver(settings.solver_name, settings.solver);
+      solver_->set_damping(settings.damping);
     } catch (const InputError& e) {
       settings.mesh_node.fail("file", e.what());
     }
@@ -386,6 +393,7 @@ class Part final : public ContinuumPart {
   double strain_energy() const override { return solver_->strain_energy(); }
   double external_work() const override { return solver_->external_work(); }
   double verlet_correction(double dt) const override { return solver_->verlet_correction(dt); }
+  double dissipated() const override { return solver_->dissipated(); }
   void save_state(StateArchive& archive) const override { solver_->save_state(archive, "continuum/"); }
   void load_state(const StateArchive& archive) override { solver_->load_state(archive, "continuum/"); }
 

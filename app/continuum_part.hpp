@@ -75,6 +75,7 @@ class ContinuumPart {
   // Verlet's shadow correction at step dt (ContinuumSolver::external_work, verlet_correction).
   virtual double external_work() const = 0;
   virtual double verlet_correction(double dt) const = 0;
+  virtual double dissipated() const = 0;  // by the continuum's damping, J
   // The continuum's state alone (an uncoupled scene; a coupled one saves it with the coupling).
   virtual void save_state(StateArchive& archive) const = 0;
   virtual void load_state(const StateArchive& archive) = 0;

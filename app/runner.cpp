@@ -119,10 +119,10 @@ class Outputs {
     const dem::Energies& e = energies.dem;
     const double total = energies.total();
     const auto [continuum_work, verlet] = continuum_balance_terms(scene_);
-    const double external_work = e.external_work + continuum_work;
+    const double external_work = e.external_work + continuum_work, dissipated = e.dissipated + energies.continuum_dissipated;
     const double balance =
-        total - verlet + e.dissipated + e.fracture - external_work - energies.coupling_work - initial_total;
-    for (double x : {e.kinetic, e.bond, e.contact, external_work, e.dissipated, e.fracture, total, balance})
+        total - verlet + dissipated + e.fracture - external_work - energies.coupling_work - initial_total;
+    for (double x : {e.kinetic, e.bond, e.contact, external_work, dissipated, e.fracture, total, balance})
       row_.push_back(x);
     if (scene_.continuum) {
       row_.push_back(energies.continuum_kinetic);

@@ -25,7 +25,7 @@ class Uncoupled final : public SceneModel {
   }
   SceneEnergies energies() const override {
     if (!continuum_) return {dem_.energies()};
-    return {dem_.energies(), continuum_->kinetic_energy(), continuum_->strain_energy()};
+    return {dem_.energies(), continuum_->kinetic_energy(), continuum_->strain_energy(), 0.0, continuum_->dissipated()};
   }
   std::optional<CouplingMonitorValues> monitor() const override { return std::nullopt; }
   void save_state(StateArchive& archive) const override {

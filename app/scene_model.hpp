@@ -18,11 +18,13 @@ class ContinuumPart;
 struct OutputPlan;
 
 // The energies of a row, J: the DEM's terms (zeros without DEs), the continuum's kinetic and
-// strain energy (0 without one) and the work of the multiplier forces (0 uncoupled).
+// strain energy and what its damping dissipated (0 without one) and the work of the multiplier
+// forces (0 uncoupled).
 struct SceneEnergies {
   dem::Energies dem;
   double continuum_kinetic = 0.0, continuum_strain = 0.0;
   double coupling_work = 0.0;
+  double continuum_dissipated = 0.0;
   double total() const { return dem.total() + continuum_kinetic + continuum_strain; }
 };
 

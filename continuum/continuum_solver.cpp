@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/damped_step.hpp"
 #include "common/error.hpp"
 #include "continuum/petsc_session.hpp"
 
@@ -333,15 +334,38 @@ void ContinuumSolver::add_external_force(Field& f) const {
   }
 }
 
+void ContinuumSolver::set_damping(double coefficient) {
+  damping_ = coefficient;
+  damping_force_.assign(u_.size(), 0.0);  // until the next compute_forces (the state at rest)
+}
+
 void ContinuumSolver::compute_forces() {
   internal_force(u_, f_);
   for (double& v : f_) v = -v;
   add_external_force(f_);
+  if (!(damping_ > 0.0)) return;
+  for (size_t d = 0; d < f_.size(); ++d) {
+    damping_force_[d] = is_fixed_[d] ? 0.0 : -damping_ * mass_[d / 3] * v_[d];
+    f_[d] += damping_force_[d];
+  }
 }
 
 void ContinuumSolver::kick(double dt) {
-  for (size_t d = 0; d < v_.size(); ++d)
-    if (!is_fixed_[d]) v_[d] += dt * f_[d] / mass_[d / 3];
+  if (!(damping_ > 0.0)) {
+    for (size_t d = 0; d < v_.size(); ++d)
+      if (!is_fixed_[d]) v_[d] += dt * f_[d] / mass_[d / 3];
+    return;
+  }
+  // A kick changes a dof's kinetic energy by dt f (v + v')/2 exactly; the damping force's share
+  // of that is the energy it dissipated (as DemModel::kick).
+  double work = 0.0;
+  for (size_t d = 0; d < v_.size(); ++d) {
+    if (is_fixed_[d]) continue;
+    const double v = v_[d];
+    v_[d] += dt * f_[d] / mass_[d / 3];
+    work -= dt * damping_force_[d] * 0.5 * (v + v_[d]);
+  }
+  dissipated_ += work;
 }
 
 void ContinuumSolver::drift(double dt) {
@@ -400,6 +424,8 @@ void ContinuumSolver::save_state(StateArchive& archive, const std::string& prefi
   archive.put(prefix + "f", f_);
   archive.put(prefix + "time", t_);
   archive.put(prefix + "external_work", external_work_);
+  archive.put(prefix + "damping_force", damping_force_);
+  archive.put(prefix + "dissipated", dissipated_);
 }
 
 void ContinuumSolver::load_state(const StateArchive& archive, const std::string& prefix) {
@@ -410,6 +436,11 @@ void ContinuumSolver::load_state(const StateArchive& archive, const std::string&
   archive.get_into(prefix + "f", f_);
   t_ = archive.number(prefix + "time");
   external_work_ = archive.number(prefix + "external_work");
+  damping_force_ = archive.get<double>(prefix + "damping_force");
+  if (!damping_force_.empty() && damping_force_.size() != f_.size())
+    throw StateMismatch("'" + prefix + "damping_force' holds " + std::to_string(damping_force_.size()) + " values, this scene has " +
+                        std::to_string(f_.size()));
+  dissipated_ = archive.number(prefix + "dissipated");
 }
 
 double ContinuumSolver::verlet_correction(double dt) const {
@@ -449,7 +480,7 @@ double ContinuumSolver::critical_time_step() const {
     x.swap(y);
   }
   if (!(lambda > 0)) throw RunError("continuum: could not estimate the highest frequency");
-  return 2.0 / std::sqrt(lambda);
+  return damped_critical_step(lambda, damping_);
 }
 
 // Static solve on PETSC_COMM_WORLD. Rows follow PETSc's default split, by whole nodes

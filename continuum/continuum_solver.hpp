@@ -109,11 +109,17 @@ class ContinuumSolver {
   Field& velocity() { return v_; }
   const Field& displacement() const { return u_; }
   const Field& velocity() const { return v_; }
-  const Field& force() const { return f_; }  // f_ext(t) - f_int(u) from the last compute_forces
+  const Field& force() const { return f_; }  // f_ext(t) - f_int(u) - damping from the last compute_forces
   double time() const { return t_; }
 
+  // Viscous (mass-proportional) damping, force -c m v on every free dof, c in 1/s, from the
+  // velocity at compute_forces() (the half-step velocity in a step), as the DEM's
+  // (DemModel::set_damping): quasi-static runs, and the same arms as a damped DEM in a coupled
+  // scene. It lowers critical_time_step() (common/damped_step.hpp); dissipated() is its work.
+  void set_damping(double coefficient);
+  double dissipated() const { return dissipated_; }  // J, >= 0
   void compute_forces();
-  void kick(double dt);   // v += dt M^-1 f on free components
+  void kick(double dt);   // v += dt M^-1 f on free components (and the damping's work)
   void drift(double dt);  // u += dt v on free components; t += dt; fixed ones follow g
   // One velocity-Verlet step; it also adds the step's external work (external_work()).
   void step(double dt);
@@ -228,6 +234,9 @@ class ContinuumSolver {
   Field u_, v_, f_;
   double t_ = 0.0;
   double external_work_ = 0.0;
+  double damping_ = 0.0;         // 1/s
+  Field damping_force_;          // N per dof, of the last compute_forces (both half kicks use it)
+  double dissipated_ = 0.0;      // J
   // step()'s scratch: with tractions, u and f_ext at the step's start and f_ext at its end; the
   // prescribed dofs' u and f at the step's start.
   Field step_u_, step_f_ext_, step_f_ext_new_, step_fixed_u_, step_f_fixed_;

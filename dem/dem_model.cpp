@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "common/damped_step.hpp"
 #include "common/error.hpp"
 
 namespace arlequin::dem {
@@ -139,15 +140,8 @@ double DemModel::critical_time_step() const {
   }
   double omega2 = 0.0;
   for (std::size_t i = 0; i < n; ++i) omega2 = std::max({omega2, trans[i], rot[i]});
-  // Viscous damping c is applied from the half-step velocity (apply_loads_and_damping), so a
-  // mode of frequency omega steps as v' = (1 - c dt) v - dt omega^2 x, x' = x + dt v'; its
-  // amplification matrix has det 1 - c dt and trace 2 - c dt - dt^2 omega^2, and both roots stay
-  // inside the unit circle iff dt^2 omega^2 + 2 c dt < 4 (Jury's conditions; derived here,
-  // docs/theory.md#critical-step): dt_c = 4 / (c + sqrt(c^2 + 4 omega^2)), which is 2/omega
-  // undamped (to the bit) and 2/c for a DE without bonds.
-  const double c = damping_;
-  double dt_c = !(omega2 > 0.0) && !(c > 0.0) ? std::numeric_limits<double>::infinity()
-                                               : 4.0 / (c + std::sqrt(c * c + 4.0 * omega2));
+  // Viscous damping is applied from the half-step velocity (apply_loads_and_damping).
+  double dt_c = damped_critical_step(omega2, damping_);
   // With contact, a DE that moves more than its radius in a step can pass through another
   // unseen: the step is also bounded by R_i / |v_i| at the present speeds (check_finite stops a
   // run whose DEs later move faster than that).
@@ -502,7 +496,7 @@ void DemModel::check_contact_resolution(const ContactResolution& worst) const {
         << " N/m) is too soft to stop this impact within the spheres (an impact of energy E needs about "
            "K >= 2 E / R^2); raise dem.contact.stiffness";
   } else {
-    const double limit = 4.0 / (damping_ + std::sqrt(damping_ * damping_ + 4.0 * worst.omega2));
+    const double limit = damped_critical_step(worst.omega2, damping_);
     msg << at(worst.crowded) << " touches " << touching_[worst.crowded] << " DEs at once: with its bonds and "
         << contact_->stiffness() << " N/m per contact its critical step is " << limit << " s, below the step " << dt
         << " s set for the contacts at set-up (likely cause: an impact packing DEs together); lower the time step "
