@@ -79,14 +79,6 @@ void check_same_run(const StateArchive& archive, const Scene& scene, const std::
   }
 }
 
-long restart_step(const StateArchive& archive, const std::filesystem::path& file) {
-  try {
-    return static_cast<long>(archive.integer("run/steps_done"));
-  } catch (const StateMismatch& e) {
-    throw InputError("'" + file.string() + "' is not an arlequin run's checkpoint: " + e.what());
-  }
-}
-
 void load_scene_state(Scene& scene, const StateArchive& archive, const std::filesystem::path& file) {
   try {
     scene.model->load_state(archive);

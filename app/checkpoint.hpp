@@ -25,8 +25,6 @@ void check_same_run(const StateArchive& archive, const Scene& scene, const std::
 // The first key (dotted path) where two resolved cases differ, other than time.end and the
 // output section; empty when they agree there.
 std::string case_difference(const std::string& checkpoint_yaml, const std::string& scene_yaml);
-// The step the checkpoint was written after (InputError if it has none).
-long restart_step(const StateArchive& archive, const std::filesystem::path& file);
 // load_state of the scene's models, a StateMismatch becoming the InputError "FILE is not a
 // checkpoint of this scene: ...".
 void load_scene_state(Scene& scene, const StateArchive& archive, const std::filesystem::path& file);

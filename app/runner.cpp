@@ -12,6 +12,9 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <random>
+
+#include <unistd.h>
 
 #include "common/atomic_file.hpp"
 #include "common/csv_series.hpp"
@@ -42,16 +45,21 @@ double seconds_since(Clock::time_point t0) {
 }
 
 
-// The fields file a run left in `dir`: fields.h5, or the .part file of a writer that was killed.
-std::filesystem::path earlier_fields_file(const std::filesystem::path& dir) {
-  std::filesystem::path found = dir / "fields.h5";
-  if (std::filesystem::exists(found)) return found;
+// The fields files runs left in `dir`, newest first: fields.h5 and the .part files of writers
+// that were killed (not this process's own, which it is writing).
+std::vector<std::filesystem::path> earlier_fields_files(const std::filesystem::path& dir) {
+  const std::string own = "fields.h5.part." + std::to_string(::getpid());
+  std::vector<std::pair<std::filesystem::file_time_type, std::filesystem::path>> found;
   std::error_code ec;
-  std::filesystem::file_time_type newest{};
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-    if (entry.path().filename().string().starts_with("fields.h5.part.") && entry.last_write_time(ec) >= newest)
-      newest = entry.last_write_time(ec), found = entry.path();
-  return found;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if ((name == "fields.h5" || name.starts_with("fields.h5.part.")) && name != own)
+      found.emplace_back(entry.last_write_time(ec), entry.path());
+  }
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::filesystem::path> files;
+  for (const auto& f : found) files.push_back(f.second);
+  return files;
 }
 
 // Writes the output files of one run; every file is replaced atomically. A restarted run
@@ -59,12 +67,17 @@ std::filesystem::path earlier_fields_file(const std::filesystem::path& dir) {
 // frames the checkpoint counts.
 class Outputs {
  public:
-  Outputs(const Scene& scene, const StateArchive* restart, const std::filesystem::path& checkpoint_dir) : scene_(scene) {
+  // `run`: the run's identity, which tags its fields file (carried over by restarts).
+  Outputs(const Scene& scene, std::uint64_t run, const StateArchive* restart, const std::filesystem::path& checkpoint_dir)
+      : scene_(scene), run_(run) {
     std::error_code ec;
     std::filesystem::create_directories(scene.output.dir, ec);
     if (ec) throw InputError("cannot create the output folder '" + scene.output.dir.string() + "': " + ec.message());
     const bool fields = scene.output.particle_fields || scene.output.bond_fields || scene.output.continuum_fields;
-    if (fields) fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+    if (fields) {
+      fields_.emplace(scene.output.dir / "fields.h5", scene.output.dir / "fields.xdmf");
+      fields_->tag(run);
+    }
     // The frames before the restart, while a killed writer's file is still there.
     if (fields && restart) carry_frames(*restart, checkpoint_dir);
     // A folder run before holds its outputs: what a killed writer left half done goes, and so
@@ -96,6 +109,7 @@ class Outputs {
     for (std::size_t r = 0; r < rows_on_schedule_; ++r) rows.insert(rows.end(), series_->row(r).begin(), series_->row(r).end());
     archive.put("run/series", rows);
     archive.put("run/frames", static_cast<std::int64_t>(frames_on_schedule_));
+    archive.put("run/frame_times", fields_ ? fields_->frame_times(frames_on_schedule_) : std::vector<double>{});
     archive.put_text("run/frames_index", fields_ ? fields_->frames_index(frames_on_schedule_) : "");
   }
 
@@ -264,31 +278,35 @@ class Outputs {
     breaks_last_write_ = now;
   }
 
+  // The columns were checked against the scene's before (run_scene).
   void restore_rows(const StateArchive& restart) {
-    std::string columns;
-    for (const auto& c : series_->columns()) columns += c + ",";
-    if (restart.text("run/series_columns") != columns)
-      throw StateMismatch("its series.csv has the columns '" + restart.text("run/series_columns") + "', this scene '" + columns + "'");
     const auto rows = restart.get<double>("run/series");
     const std::size_t width = series_->columns().size();
-    if (rows.size() % width != 0) throw StateMismatch("its series rows are not whole rows");
     for (std::size_t at = 0; at < rows.size(); at += width) series_->append(std::span<const double>(rows).subspan(at, width));
     rows_on_schedule_ = series_->rows();
   }
 
+  // The frames of the checkpoint, from the first fields file of its folder that holds them (at
+  // their times): fields.h5, or what a killed writer left, newest first.
   void carry_frames(const StateArchive& restart, const std::filesystem::path& dir) {
-    const auto frames = static_cast<std::size_t>(restart.integer("run/frames"));
-    if (frames == 0) return;
-    try {
-      fields_->carry_frames(earlier_fields_file(dir), frames, restart.text("run/frames_index"));
-      frames_on_schedule_ = frames_carried_ = frames;
-    } catch (const RunError& e) {
-      std::fprintf(stderr, "  warning: the %zu frames before the restart are not carried over (%s); fields.xdmf holds the frames from the restart on\n",
-                   frames, e.what());
+    const auto times = restart.get<double>("run/frame_times");
+    if (times.empty()) return;
+    std::string why = "no fields.h5 in '" + dir.string() + "'";
+    for (const auto& file : earlier_fields_files(dir)) {
+      try {
+        fields_->carry_frames(file, run_, times, restart.text("run/frames_index"));
+        frames_on_schedule_ = frames_carried_ = times.size();
+        return;
+      } catch (const RunError& e) {
+        why = e.what();
+      }
     }
+    std::fprintf(stderr, "  warning: the %zu frames before the restart are not carried over (%s); fields.xdmf holds the frames from the restart on\n",
+                 times.size(), why.c_str());
   }
 
   const Scene& scene_;
+  std::uint64_t run_;
   std::size_t rows_on_schedule_ = 0, frames_on_schedule_ = 0;
   std::size_t frames_carried_ = 0;  // frames copied from before a restart
   std::optional<CsvSeries> series_;
@@ -420,21 +438,6 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const bool static_only = scene.static_only();  // one solve, whatever --steps says
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
-  const StateArchive* restart = options.restart;
-  if (restart) {
-    check_same_run(*restart, scene, options.restart_file);
-    if (const long at = restart_step(*restart, options.restart_file); at > scene.steps)
-      throw InputError("'" + options.restart_file.string() + "' is at step " + std::to_string(at) + ", past this case's last step " +
-                       std::to_string(scene.steps) + " (time.end " + std::to_string(scene.end_time) + " s)");
-    load_scene_state(scene, *restart, options.restart_file);
-  }
-  std::optional<Outputs> outputs_or;
-  try {
-    outputs_or.emplace(scene, restart, options.restart_file.parent_path());
-  } catch (const StateMismatch& e) {
-    throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
-  }
-  Outputs& outputs = *outputs_or;
   RunResult result;
   double initial_total = scene.model->energies().total() - continuum_balance_terms(scene).second;
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
@@ -445,7 +448,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   // a stiffest spring k ~ m (2 / dt_c)^2 stretched by a rounding error of position eps X
   // accelerates its DE by ~ eps X / dt_c^2, so after a time t the DEs move at ~ eps X t / dt_c^2;
   // the energy scale is at least that motion's, round_off (eps X / dt_c) times (t / dt_c)^2
-  // (~4e-21 J there after 5600 steps).
+  // (~4e-21 J there after 5600 steps). Both from the scene as built, before a restart moves it.
   double energy_scale = std::abs(initial_total);
   const double round_off = model.round_off_kinetic_energy(scene.dt_critical);
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
@@ -454,12 +457,67 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   // Float steps accumulate round-off: an output is due within a millionth of a step.
   const double slack = 1e-6 * scene.dt;
   long steps_done = 0;
+  // Tags the run's fields file, so that a restart takes frames from its own run's file only; a
+  // restarted run keeps its run's. Not a simulation value: nothing in the physics reads it.
+  std::uint64_t run_id = (std::uint64_t{std::random_device{}()} << 32) ^ std::random_device{}() ^
+                         static_cast<std::uint64_t>(Clock::now().time_since_epoch().count());
+
+  // A restart: every refusal before any output is touched, then the state.
+  const StateArchive* restart = options.restart;
+  if (restart) {
+    const std::string file = "'" + options.restart_file.string() + "'";
+    check_same_run(*restart, scene, options.restart_file);
+    try {
+      run_id = static_cast<std::uint64_t>(restart->integer("run/id"));
+      steps_done = restart->integer("run/steps_done");
+      if (steps_done < 0 || (model.particles.size() > 0 && restart->integer("dem/steps") != steps_done))
+        throw StateMismatch("its step counts disagree (run " + std::to_string(steps_done) + ")");
+      next_row = restart->number("run/next_row");
+      next_frame = restart->number("run/next_frame");
+      initial_total = restart->number("run/initial_total");
+      energy_scale = restart->number("run/energy_scale");
+      std::string columns;
+      for (const auto& c : series_columns(scene)) columns += c + ",";
+      if (restart->text("run/series_columns") != columns)
+        throw StateMismatch("its series.csv has the columns '" + restart->text("run/series_columns") + "', this scene '" + columns + "'");
+      if (restart->get<double>("run/series").size() % series_columns(scene).size() != 0)
+        throw StateMismatch("its series rows are not whole rows");
+      const auto frame_times = restart->get<double>("run/frame_times");
+      if (static_cast<std::int64_t>(frame_times.size()) != restart->integer("run/frames") || !restart->has("run/frames_index"))
+        throw StateMismatch("its frame count and frame times disagree");
+      const auto names = series_columns(scene);
+      const auto sensors = restart->get<double>("run/sensors");
+      for (std::size_t k = 0; k < sensors.size() && k + 2 < names.size(); ++k) result.sensors.emplace_back(names[k + 2], sensors[k]);
+      result.damage_in_overlap = restart->text("run/damage_in_overlap");
+      result.damage_in_overlap_breaks = static_cast<std::size_t>(restart->integer("run/damage_in_overlap_breaks"));
+    } catch (const StateMismatch& e) {
+      throw InputError(file + " is not a checkpoint of this scene: " + e.what());
+    }
+    // A restart has steps to run: a finished run is extended by a later time.end.
+    if (steps_done >= scene.steps)
+      throw InputError(file + " is at step " + std::to_string(steps_done) + (steps_done == scene.steps ? ", the last" : ", past the last") +
+                       " of this case (time.end " + std::to_string(scene.end_time) + " s): give a later time.end to continue it");
+    if (total_steps <= steps_done)
+      throw InputError("--steps " + std::to_string(total_steps) + ": the run stops at or before " + file + "'s step " +
+                       std::to_string(steps_done) + ", where it restarts");
+    next_checkpoint = steps_done * scene.dt + checkpoint_every;  // the case's interval, from here
+    load_scene_state(scene, *restart, options.restart_file);
+  }
+  std::optional<Outputs> outputs_or;
+  try {
+    outputs_or.emplace(scene, run_id, restart, options.restart_file.parent_path());
+  } catch (const StateMismatch& e) {
+    throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
+  }
+  Outputs& outputs = *outputs_or;
   // The runner's part of the checkpoint: where the run is, its output schedule, the scales its
   // checks use, and what it has reported; the rows and frames are the outputs'.
+  std::string checkpoint_error;  // the first checkpoint that could not be written
   const auto save_checkpoint = [&] {
     StateArchive archive;
     put_run_identity(archive, scene);
     scene.model->save_state(archive);
+    archive.put("run/id", static_cast<std::int64_t>(run_id));
     archive.put("run/steps_done", std::int64_t{steps_done});
     for (const auto& [name, value] : {std::pair{"next_row", next_row}, {"next_frame", next_frame}, {"initial_total", initial_total}, {"energy_scale", energy_scale}})
       archive.put("run/" + std::string(name), value);
@@ -469,25 +527,16 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     archive.put_text("run/damage_in_overlap", result.damage_in_overlap);
     archive.put("run/damage_in_overlap_breaks", static_cast<std::int64_t>(result.damage_in_overlap_breaks));
     outputs.save_state(archive);
-    write_state_file(scene.output.dir / checkpoint_file_name, archive);
-  };
-  if (restart) {
+    // A checkpoint that cannot be written (a full disk) does not stop the run: the last one stays.
     try {
-      steps_done = restart->integer("run/steps_done");
-      next_row = restart->number("run/next_row");
-      next_frame = restart->number("run/next_frame");
-      next_checkpoint = steps_done * scene.dt + checkpoint_every;  // the case's interval, from here
-      initial_total = restart->number("run/initial_total");
-      energy_scale = restart->number("run/energy_scale");
-      const auto names = series_columns(scene);
-      const auto sensors = restart->get<double>("run/sensors");
-      for (std::size_t k = 0; k < sensors.size() && k + 2 < names.size(); ++k) result.sensors.emplace_back(names[k + 2], sensors[k]);
-      result.damage_in_overlap = restart->text("run/damage_in_overlap");
-      result.damage_in_overlap_breaks = static_cast<std::size_t>(restart->integer("run/damage_in_overlap_breaks"));
-    } catch (const StateMismatch& e) {
-      throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
+      write_state_file(scene.output.dir / checkpoint_file_name, archive);
+    } catch (const RunError& e) {
+      if (checkpoint_error.empty()) {
+        std::fprintf(stderr, "  warning: %s; the run goes on, its last checkpoint stays\n", e.what());
+        checkpoint_error = e.what();
+      }
     }
-  }
+  };
   const long first_step = steps_done;
   Progress progress(options.show_progress, options.announce_run_time, first_step, total_steps);
   const auto current_time = [&] { return steps_done * scene.dt; };
@@ -564,14 +613,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     interrupted = std::current_exception();
   }
   // The state at the end, or where a signal stopped the run: between two steps, so whole.
-  std::string checkpoint_error;
-  if (!static_only && (interrupted || (failure.empty() && checkpoint_every > 0.0))) {
-    try {
-      save_checkpoint();
-    } catch (const RunError& e) {
-      checkpoint_error = e.what();
-    }
-  }
+  if (!static_only && (interrupted || (failure.empty() && checkpoint_every > 0.0))) save_checkpoint();
   progress.finish();
   result.steps = steps_done;
   result.simulated_time = current_time();

@@ -193,24 +193,49 @@ std::string FieldsWriter::frames_index(std::size_t frames) const {
   return index;
 }
 
-void FieldsWriter::carry_frames(const std::filesystem::path& earlier, std::size_t frames, const std::string& index) {
+void FieldsWriter::tag(std::uint64_t run) {
+  const Handle space(checked(H5Screate(H5S_SCALAR), part_path_, "create dataspace for", "run"), H5Sclose);
+  const Handle attribute(checked(H5Acreate2(file_, "run", H5T_NATIVE_UINT64, space, H5P_DEFAULT, H5P_DEFAULT), part_path_,
+                                 "create attribute", "run"),
+                         H5Aclose);
+  checked(H5Awrite(attribute, H5T_NATIVE_UINT64, &run), part_path_, "write attribute", "run");
+}
+
+void FieldsWriter::carry_frames(const std::filesystem::path& earlier, std::uint64_t run, const std::vector<double>& times,
+                                const std::string& index) {
   if (file_ < 0 || in_frame_ || frame_count_ > 0) throw std::logic_error("FieldsWriter::carry_frames: only before the first frame");
-  if (frames == 0) return;
+  if (times.empty()) return;
   if (H5Fis_hdf5(earlier.c_str()) <= 0) throw RunError("'" + earlier.string() + "' is not a readable HDF5 file");
   const Handle source(checked(H5Fopen(earlier.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), earlier, "open", "file"), H5Fclose);
-  for (std::size_t k = 0; k < frames; ++k) {
-    char path[32];
-    std::snprintf(path, sizeof path, "/frames/%06zu", k);
-    if (H5Lexists(source, "/frames", H5P_DEFAULT) <= 0 || H5Lexists(source, path, H5P_DEFAULT) <= 0) {
-      // Leave the file as it was: no frame carried.
-      if (k > 0) checked(H5Ldelete(file_, "/frames", H5P_DEFAULT), part_path_, "remove", "/frames");
-      throw RunError("'" + earlier.string() + "' has no frame " + std::to_string(k) + " (" + std::to_string(frames) + " expected)");
+  std::uint64_t theirs = 0;
+  if (H5Aexists(source, "run") <= 0 ||
+      H5Aread(Handle(checked(H5Aopen(source, "run", H5P_DEFAULT), earlier, "open", "run"), H5Aclose), H5T_NATIVE_UINT64, &theirs) < 0 ||
+      theirs != run)
+    throw RunError("'" + earlier.string() + "' holds another run's frames");
+  try {
+    for (std::size_t k = 0; k < times.size(); ++k) {
+      char path[32];
+      std::snprintf(path, sizeof path, "/frames/%06zu", k);
+      double time = 0.0;
+      if (H5Lexists(source, "/frames", H5P_DEFAULT) <= 0 || H5Lexists(source, path, H5P_DEFAULT) <= 0 ||
+          H5Aexists_by_name(source, path, "time", H5P_DEFAULT) <= 0)
+        throw RunError("'" + earlier.string() + "' has no frame " + std::to_string(k) + " (" + std::to_string(times.size()) + " expected)");
+      const Handle attribute(checked(H5Aopen_by_name(source, path, "time", H5P_DEFAULT, H5P_DEFAULT), earlier, "open", path), H5Aclose);
+      checked(H5Aread(attribute, H5T_NATIVE_DOUBLE, &time), earlier, "read the time of", path);
+      if (time != times[k])
+        throw RunError("frame " + std::to_string(k) + " of '" + earlier.string() + "' is at t = " + number_text(time) +
+                       " s, not " + number_text(times[k]) + " s: another run's");
+      checked(H5Ocopy(source, path, file_, path, H5P_DEFAULT, intermediate_groups(part_path_, path)), part_path_, "copy", path);
     }
-    checked(H5Ocopy(source, path, file_, path, H5P_DEFAULT, intermediate_groups(part_path_, path)), part_path_, "copy", path);
+  } catch (...) {
+    // Leave the file as it was: no frame carried.
+    if (H5Lexists(file_, "/frames", H5P_DEFAULT) > 0) H5Ldelete(file_, "/frames", H5P_DEFAULT);
+    throw;
   }
   frames_xml_ = index;
   replace_all(frames_xml_, file_token, h5_reference_ + ":");
-  frame_count_ = frames;
+  frame_times_ = times;
+  frame_count_ = times.size();
   checked(H5Fflush(file_, H5F_SCOPE_LOCAL), part_path_, "flush", "file");
   write_xdmf();
 }
@@ -349,6 +374,7 @@ void FieldsWriter::finish_frame() {
   for (const Grid& grid : grids_)
     xml += "<Grid Name=\"" + xml_escaped(grid.name) + "\" GridType=\"Uniform\">\n" + grid.xml + "</Grid>\n";
   frames_xml_ += xml + "</Grid>\n";
+  frame_times_.push_back(frame_time_);
   grids_.clear();
   ++frame_count_;
 }

@@ -16,6 +16,7 @@
 // is the MPI build, and MPI is never initialised here.
 #pragma once
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -71,13 +72,20 @@ class FieldsWriter {
 
   std::size_t frames() const { return frame_count_; }
 
-  // Restart (app/checkpoint.hpp). frames_index(): the XDMF of the first `frames` finished frames
-  // with the HDF5 file's name left out. carry_frames(): copies frames [0, frames) of `earlier` (a file this class
-  // wrote) into this writer's file and takes `index` (frames_index() of the writer that wrote
-  // them) as their XDMF, so the frames go on from there; only before the first frame. RunError
-  // when `earlier` cannot be read or lacks one of those frames (then nothing was carried).
+  // Restart (app/checkpoint.hpp). frames_index() and frame_times(): the XDMF of the first `frames`
+  // finished frames with the HDF5 file's name left out, and their times. carry_frames(): copies
+  // the first times.size() frames of `earlier` (a file this class wrote) into this writer's file
+  // and takes `index` (frames_index() of the writer that wrote them) as their XDMF, so the frames
+  // go on from there; only before the first frame. RunError when `earlier` cannot be read, is
+  // not tagged with `run` (another run's), lacks one of those frames or has one at another time;
+  // then nothing was carried. tag(): the run a file's frames belong to (a root attribute).
+  void tag(std::uint64_t run);
   std::string frames_index(std::size_t frames) const;
-  void carry_frames(const std::filesystem::path& earlier, std::size_t frames, const std::string& index);
+  std::vector<double> frame_times(std::size_t frames) const {
+    return {frame_times_.begin(), frame_times_.begin() + static_cast<std::ptrdiff_t>(std::min(frames, frame_times_.size()))};
+  }
+  void carry_frames(const std::filesystem::path& earlier, std::uint64_t run, const std::vector<double>& times,
+                    const std::string& index);
 
  private:
   struct Column;  // typed view of values to store (defined in the .cpp)
@@ -116,6 +124,7 @@ class FieldsWriter {
   std::string frame_path_;    // "/frames/000042"
   std::vector<Grid> grids_;   // grids of the open frame
   std::string frames_xml_;    // finished frames, as XDMF
+  std::vector<double> frame_times_;  // of the finished frames
 };
 
 }  // namespace arlequin

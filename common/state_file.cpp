@@ -66,24 +66,39 @@ void write_entry(hid_t file, const std::string& name, const StateArchive::Entry&
 void write_state_file(const std::filesystem::path& path, const StateArchive& archive) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   const std::filesystem::path temporary = temporary_path_for(path);
-  {
-    Hdf5Handle file(H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-    if (file < 0) throw RunError("HDF5: cannot create '" + temporary.string() + "'");
-    const std::string index = index_of(archive);
-    StateArchive::Entry index_entry{ElementKind::text, 1, index.size(), {}};
-    index_entry.bytes.resize(index.size());
-    std::memcpy(index_entry.bytes.data(), index.data(), index.size());
-    write_entry(file, "index", index_entry, temporary);
-    for (const auto& [name, e] : archive.entries()) write_entry(file, name, e, temporary);
-    const std::uint64_t sum = checksum(index, archive);
-    Hdf5Handle scalar(H5Screate(H5S_SCALAR), H5Sclose);
-    Hdf5Handle attribute(H5Acreate2(file, "checksum", H5T_NATIVE_UINT64, scalar, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
-    if (attribute < 0 || H5Awrite(attribute, H5T_NATIVE_UINT64, &sum) < 0)
-      throw RunError("HDF5: cannot write the checksum of '" + temporary.string() + "'");
-  }
   std::error_code ec;
+  try {
+    const hid_t file = H5Fcreate(temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (file < 0) throw RunError("HDF5: cannot create '" + temporary.string() + "'");
+    try {
+      const std::string index = index_of(archive);
+      StateArchive::Entry index_entry{ElementKind::text, 1, index.size(), {}};
+      index_entry.bytes.resize(index.size());
+      std::memcpy(index_entry.bytes.data(), index.data(), index.size());
+      write_entry(file, "index", index_entry, temporary);
+      for (const auto& [name, e] : archive.entries()) write_entry(file, name, e, temporary);
+      const std::uint64_t sum = checksum(index, archive);
+      Hdf5Handle scalar(H5Screate(H5S_SCALAR), H5Sclose);
+      Hdf5Handle attribute(H5Acreate2(file, "checksum", H5T_NATIVE_UINT64, scalar, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+      if (attribute < 0 || H5Awrite(attribute, H5T_NATIVE_UINT64, &sum) < 0)
+        throw RunError("HDF5: cannot write the checksum of '" + temporary.string() + "'");
+    } catch (...) {
+      H5Fclose(file);
+      throw;
+    }
+    // HDF5 writes its buffers at close: a close that fails (a full disk) leaves a file that must
+    // not replace the last good checkpoint.
+    if (H5Fclose(file) < 0) throw RunError("HDF5: cannot finish writing '" + temporary.string() + "'");
+  } catch (...) {
+    std::filesystem::remove(temporary, ec);
+    throw;
+  }
   std::filesystem::rename(temporary, path, ec);
-  if (ec) throw RunError("cannot rename '" + temporary.string() + "' to '" + path.string() + "': " + ec.message());
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw RunError("cannot rename '" + temporary.string() + "' to '" + path.string() + "': " + ec.message());
+  }
 }
 
 StateArchive read_state_file(const std::filesystem::path& path) {
@@ -98,9 +113,12 @@ StateArchive read_state_file(const std::filesystem::path& path) {
     Hdf5Handle set(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
     if (set < 0) throw bad("'" + name + "' is missing (truncated or corrupted)");
     Hdf5Handle space(H5Dget_space(set), H5Sclose);
-    const hssize_t count = space < 0 ? -1 : H5Sget_simple_extent_npoints(space);
-    if (count < 0 || static_cast<std::size_t>(count) != e.rows * e.width)
-      throw bad("'" + name + "' does not have the size its index says (corrupted)");
+    hsize_t dims[2] = {0, 0};
+    const int rank = space < 0 ? -1 : H5Sget_simple_extent_ndims(space);
+    if (rank != (e.width > 1 ? 2 : 1) || H5Sget_simple_extent_dims(space, dims, nullptr) != rank || dims[0] != e.rows ||
+        (rank == 2 && dims[1] != e.width))
+      throw bad("'" + name + "' does not have the shape its index says (corrupted)");
+    const std::size_t count = e.rows * e.width;
     e.bytes.resize(e.rows * e.width * element_size(e.kind));
     if (count > 0 && H5Dread(set, memory_type(e.kind), H5S_ALL, H5S_ALL, H5P_DEFAULT, e.bytes.data()) < 0)
       throw bad("'" + name + "' cannot be read (truncated or corrupted)");
@@ -125,6 +143,8 @@ StateArchive read_state_file(const std::filesystem::path& path) {
         kind > static_cast<int>(ElementKind::text) || e.width == 0)
       throw bad("/index line '" + line + "' is not 'name kind width rows' (corrupted)");
     e.kind = static_cast<ElementKind>(kind);
+    // Sizes a file of ours cannot hold (what rows x width x element size would overflow).
+    if (e.rows > (std::size_t{1} << 40) / e.width) throw bad("/index line '" + line + "' gives an impossible size (corrupted)");
     read(name, e);
     archive.put_entry(name, std::move(e));
   }

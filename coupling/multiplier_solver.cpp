@@ -80,7 +80,10 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
     const int k = factor_of_[c];
     column_ = rhs.col(c).cwiseProduct(scales_[k]);
     if (!petsc_.empty()) {
-      solution_.resize(column_.size());
+      // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
+      // from another component or step would make the multipliers depend on the run's history,
+      // which a restart (docs/restart.md) could not reproduce.
+      solution_.setZero(column_.size());
       petsc_[k]->solve(column_.data(), solution_.data());
       lambda.col(c) = solution_.cwiseProduct(scales_[k]);
       continue;

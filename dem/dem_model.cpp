@@ -578,9 +578,7 @@ void DemModel::load_state(const StateArchive& archive) {
     throw StateMismatch("it has more bond sets than this scene's " + std::to_string(bond_sets_.size()));
   if (neighbours_) {
     neighbours_->set_exclusions(intact_bonded_pairs());
-    neighbours_->load_state(archive, "dem/neighbours/");
-    for (const auto& [i, j] : neighbours_->pairs())
-      if (i >= p.size() || j >= p.size()) throw StateMismatch("its contact pairs name DEs beyond this scene's");
+    neighbours_->load_state(archive, "dem/neighbours/", p.size());
   }
   const auto time = archive.get<double>("dem/breaks/time"), stress = archive.get<double>("dem/breaks/stress"),
              energy = archive.get<double>("dem/breaks/energy"), mode_mix = archive.get<double>("dem/breaks/mode_mix");

@@ -93,9 +93,14 @@ void NeighbourList::save_state(StateArchive& archive, const std::string& prefix)
   archive.put(prefix + "builds", static_cast<std::int64_t>(builds_));
 }
 
-void NeighbourList::load_state(const StateArchive& archive, const std::string& prefix) {
+void NeighbourList::load_state(const StateArchive& archive, const std::string& prefix, std::size_t n_particles) {
   pairs_ = archive.get<std::pair<std::uint32_t, std::uint32_t>>(prefix + "pairs");
+  for (const auto& [i, j] : pairs_)
+    if (!(i < j && j < n_particles)) throw StateMismatch("its contact pairs name DEs beyond this scene's");
   position_at_build_ = archive.get<Vec3>(prefix + "position_at_build");
+  if (position_at_build_.size() != n_particles)
+    throw StateMismatch("its contact search was built for " + std::to_string(position_at_build_.size()) + " DEs, this scene has " +
+                        std::to_string(n_particles));
   builds_ = static_cast<std::size_t>(archive.integer(prefix + "builds"));
 }
 

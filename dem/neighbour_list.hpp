@@ -29,9 +29,10 @@ class NeighbourList {
   double skin() const { return skin_; }
   // Checkpoint: the list and the positions it was built at (so the restarted run rebuilds when
   // the uninterrupted one would, with the pairs in the same order), under `prefix`. The
-  // exclusions are the caller's to set again.
+  // exclusions are the caller's to set again. load_state: StateMismatch unless the list is of
+  // n_particles DEs (each pair i < j < n_particles).
   void save_state(StateArchive& archive, const std::string& prefix) const;
-  void load_state(const StateArchive& archive, const std::string& prefix);
+  void load_state(const StateArchive& archive, const std::string& prefix, std::size_t n_particles);
 
  private:
   double skin_;

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -125,26 +126,36 @@ fs::path lattice_checkpoint(const std::string& name) {
   return out / "checkpoint.h5";
 }
 
-TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
-  const fs::path out = test::scratch_dir("restart_sigint"), stopped = out / "stopped", whole = out / "whole";
-  // Ten times the case's time: a run of several seconds, stopped after one; no checkpoint_every.
-  const std::string run = "run " + lattice + " --quiet --set time.end=3.0e-3";
-  // Started directly (a shell's background job would ignore SIGINT), stopped after a second.
-  const std::string exe = std::string(ARLEQUIN_BINARY_DIR) + "/app/arlequin", case_file = lattice, dir = stopped.string();
+// Runs the lattice bar with `args` (split at spaces, no quoting) and sends `signal` after a
+// second; returns the wait status. Started directly: a shell's background job ignores SIGINT.
+int run_and_signal(const std::string& args, int signal) {
+  const std::string exe = std::string(ARLEQUIN_BINARY_DIR) + "/app/arlequin";
+  std::vector<std::string> words = {exe, "run", lattice, "--quiet"};
+  std::istringstream in(args);
+  for (std::string word; in >> word;) words.push_back(word);
+  std::vector<char*> argv;
+  for (auto& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
   const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
   if (pid == 0) {
     const int null = open("/dev/null", O_WRONLY);
     dup2(null, STDOUT_FILENO);
     dup2(null, STDERR_FILENO);
-    execl(exe.c_str(), exe.c_str(), "run", case_file.c_str(), "--quiet", "--set", "time.end=3.0e-3", "--out", dir.c_str(),
-          static_cast<char*>(nullptr));
+    execv(exe.c_str(), argv.data());
     _exit(127);
   }
   sleep(1);
-  kill(pid, SIGINT);
+  kill(pid, signal);
   int status = 0;
   waitpid(pid, &status, 0);
+  return status;
+}
+
+TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
+  const fs::path out = test::scratch_dir("restart_sigint"), stopped = out / "stopped", whole = out / "whole";
+  // Ten times the case's time: a run of several seconds, stopped after one; no checkpoint_every.
+  const std::string run = "run " + lattice + " --quiet --set time.end=3.0e-3";
+  const int status = run_and_signal(" --set time.end=3.0e-3 --out " + stopped.string(), SIGINT);
   ASSERT_TRUE(WIFEXITED(status));
   ASSERT_EQ(WEXITSTATUS(status), 130) << "the exit status after SIGINT: 128 + 2";
   const Json summary = Json::parse(test::read_text(stopped / "summary.json"));
@@ -159,6 +170,47 @@ TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
   ASSERT_EQ(uninterrupted.exit_code, 0) << uninterrupted.output;
   EXPECT_EQ(test::read_text(stopped / "series.csv"), test::read_text(whole / "series.csv"));
   EXPECT_EQ(test::read_text(stopped / "breaks.csv"), test::read_text(whole / "breaks.csv"));
+}
+
+// A run killed outright (SIGKILL: no outputs closed) leaves its periodic checkpoint and its
+// fields in fields.h5.part.<pid>: the restart carries the frames from there and ends with the
+// uninterrupted run's series and frames. A fields.h5 of another run in the folder is not taken.
+TEST(RestartSignal, KilledRunRestartsFromItsLastCheckpointWithItsFrames) {
+  const fs::path out = test::scratch_dir("restart_sigkill"), killed = out / "killed", whole = out / "whole";
+  const std::string settings = " --set time.end=3.0e-3 --set output.checkpoint_every=2.0e-5 --set output.fields_every=1.0e-5";
+  const int status = run_and_signal(settings + " --out " + killed.string(), SIGKILL);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  ASSERT_TRUE(fs::exists(killed / "checkpoint.h5"));
+  ASSERT_FALSE(fs::exists(killed / "fields.h5"));
+  // Another run's fields.h5 beside the .part file, newer: its frames are at other times.
+  const auto other = test::run_arlequin("run " + lattice + " --quiet --steps 2000 --set output.fields_every=7.0e-6 --out " + (out / "other").string());
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  fs::copy_file(out / "other" / "fields.h5", killed / "fields.h5");
+  const StateArchive checkpoint = read_state_file(killed / "checkpoint.h5");
+  const long end = checkpoint.integer("run/steps_done") + 300;
+  const auto again = test::run_arlequin("run " + lattice + " --quiet" + settings + " --out " + killed.string() + " --restart " +
+                                        (killed / "checkpoint.h5").string() + " --steps " + std::to_string(end));
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(again.output.find("not carried over"), std::string::npos) << again.output;
+  const auto uninterrupted = test::run_arlequin("run " + lattice + " --quiet" + settings + " --out " + whole.string() + " --steps " +
+                                                std::to_string(end));
+  ASSERT_EQ(uninterrupted.exit_code, 0) << uninterrupted.output;
+  for (const char* file : {"series.csv", "breaks.csv", "fields.xdmf"})
+    EXPECT_EQ(test::read_text(killed / file), test::read_text(whole / file)) << file;
+  EXPECT_GT(checkpoint.integer("run/frames"), 0);
+}
+
+TEST(RestartFields, AnotherRunsFieldsAreNotCarried) {
+  const fs::path file = lattice_checkpoint("fields_other"), dir = file.parent_path();
+  const auto other = test::run_arlequin("run " + lattice + " --quiet --steps 300 --set output.fields_every=7.0e-6 --out " +
+                                        test::scratch_dir("restart_fields_other_run").string());
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  fs::copy_file(test::scratch_path("restart_fields_other_run") / "fields.h5", dir / "fields.h5", fs::copy_options::overwrite_existing);
+  const auto r = test::run_arlequin("run " + lattice + " --quiet --steps 400 --out " + test::scratch_dir("restart_fields_new").string() +
+                                    " --restart " + file.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("another run's"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("are not carried over"), std::string::npos) << r.output;
 }
 
 // Each refusal: exit 2, one line naming the file and the reason, and no output written.
@@ -176,7 +228,9 @@ TEST(RestartRefusal, AnotherCaseNamesTheKeyButTimeEndAndOutputMayChange) {
   const fs::path file = lattice_checkpoint("refusal_case");
   expect_refused(" --restart " + file.string() + " --set dem.damping=1.0e4", "is a checkpoint of another case: 'dem.damping' differs");
   expect_refused(" --restart " + file.string() + " --set dem.bond.sigma_f=1.9e8", "'dem.bond.sigma_f' differs");
-  expect_refused(" --restart " + file.string() + " --set time.end=3.0e-6", "is at step 200, past this case's last step 92");
+  expect_refused(" --restart " + file.string() + " --set time.end=3.0e-6", "is at step 200, past the last of this case");
+  expect_refused(" --restart " + file.string() + " --set time.end=6.53018845964e-6", "is at step 200, the last of this case");
+  expect_refused(" --restart " + file.string() + " --steps 150", "--steps 150: the run stops at or before");
   const auto r = test::run_arlequin("run " + lattice + " --quiet --out " + test::scratch_path("restart_refusal_case").string() +
                                     " --restart " + file.string() + " --steps 300 --set time.end=4.0e-4 --set output.every=4.0e-6");
   EXPECT_EQ(r.exit_code, 0) << r.output;
