@@ -59,7 +59,7 @@ constexpr KeyDoc continuum_boundary_keys[] = {
     {"duration", KeyType::number, "s", Range::positive(), "inf", "velocity: time after which it stops"},
 };
 constexpr KeyDoc coupling_keys[] = {
-    {"overlap", KeyType::section, "", {}, "", "the overlap: a region (box or cylinder, with axis and dem_side) or a shell"},
+    {"overlap", KeyType::section, "", {}, "", "the overlap: a region (box or cylinder, with axis and dem_side), a shell or a band"},
     {"weight", KeyType::choice, "", {}, "linear", "partition-of-unity weight across the overlap", "linear | cubic | constant"},
     {"constant_value", KeyType::number, "1", Range::open_between(0, 1), "0.5", "the DEM's weight with weight: constant"},
     {"mass_floor", KeyType::number, "1", Range::open_between(0, 1), "0.05", "least weight on a mass (keeps the critical step finite)"},
@@ -75,6 +75,7 @@ constexpr KeyDoc coupling_keys[] = {
 };
 constexpr KeyDoc overlap_keys[] = {
     {"shell", KeyType::section, "", {}, "(none)", "the space between two boxes, the DEM inside (instead of a region)"},
+    {"band", KeyType::section, "", {}, "(none)", "a DEM band through a continuum, the overlap on its faces (instead of a region)"},
     {"axis", KeyType::choice, "", {}, "", "box: the axis across the overlap", "x | y | z"},
     {"dem_side", KeyType::choice, "", {}, "", "which side of the overlap is the pure-DEM zone",
      "(box: lower | upper; cylinder: base | top)"},
@@ -82,6 +83,15 @@ constexpr KeyDoc overlap_keys[] = {
 constexpr KeyDoc shell_keys[] = {
     {"inner", KeyType::vec3_list, "m", {}, "", "the inner box (pure DEM inside), two corners"},
     {"outer", KeyType::vec3_list, "m", {}, "", "the outer box (pure continuum outside), two corners"},
+};
+constexpr KeyDoc band_keys[] = {
+    {"axis", KeyType::choice, "", {}, "", "the direction across the band", "x | y | z"},
+    {"center", KeyType::number, "m", Range::any(), "", "the band's mid-plane, along axis"},
+    {"half_thickness", KeyType::number, "m", Range::positive(), "", "the DEM (overlap included) within this of the mid-plane"},
+    {"width", KeyType::number, "m", Range::positive(), "", "the overlap's width on each face, below half_thickness"},
+    {"along", KeyType::choice, "", {}, "", "the band's direction", "x | y | z"},
+    {"from", KeyType::number, "m", Range::any(), "", "where the band starts along it (the overlap also ramps there)"},
+    {"to", KeyType::number, "m", Range::any(), "", "where it ends (a free end: no overlap there)"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -91,6 +101,7 @@ constexpr SchemaSection continuum_sections[] = {
     {"coupling", "Arlequin coupling of the DEM zone and the continuum", coupling_keys},
     {"coupling.overlap", "the overlap (also the keys of region)", overlap_keys},
     {"coupling.overlap.shell", "a shell overlap", shell_keys},
+    {"coupling.overlap.band", "a band overlap: the shell of a slab, DEM inside, across all of the third direction", band_keys},
 };
 
 using continuum::ContinuumSolver;
@@ -226,6 +237,27 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
     shell.finish();
     overlap.finish();
     return coupling::OverlapZone::shell(Box{inner[0], inner[1]}, Box{outer[0], outer[1]}, weighting);
+  }
+  if (overlap.has("band")) {
+    // The shell of the slab |x[axis] - center| <= half_thickness, from <= x[along] <= to: the DEM
+    // inside, the overlap of `width` on both faces and at `from`, across all of the third direction.
+    CaseNode band = overlap.child("band");
+    const int axis = band.choice("axis", axes)[0] - 'x', along = band.choice("along", axes)[0] - 'x';
+    if (along == axis) band.fail("along", "must differ from axis");
+    const double center = band.number("center", Range::any(), "m"), half = band.number("half_thickness", Range::positive(), "m");
+    const double width = band.number("width", Range::positive(), "m");
+    if (!(width < half)) band.fail("width", "must be below half_thickness (the band needs a pure-DEM core)");
+    const double from = band.number("from", Range::any(), "m"), to = band.number("to", Range::any(), "m");
+    if (!(to > from + width)) band.fail("to", "must lie beyond from + width");
+    band.finish();
+    overlap.finish();
+    constexpr double everywhere = 1e3;  // m: the third direction's extent
+    Box inner{Vec3{-everywhere, -everywhere, -everywhere}, Vec3{everywhere, everywhere, everywhere}}, outer = inner;
+    outer.lower[axis] = center - half, outer.upper[axis] = center + half;
+    inner.lower[axis] = center - half + width, inner.upper[axis] = center + half - width;
+    outer.lower[along] = from, outer.upper[along] = to;
+    inner.lower[along] = from + width, inner.upper[along] = to;
+    return coupling::OverlapZone::shell(inner, outer, weighting);
   }
   const Region region = Region::read(overlap);
   if (const auto* box = std::get_if<Box>(&region.shape())) {

@@ -31,13 +31,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The continuum's own terms of the energy balance when it steps alone (with a DEM beside it or
-// none): its tractions' and supports' work, and velocity Verlet's shadow correction at the run's
+// The continuum's own terms of the energy balance: its tractions' and supports' work, and velocity Verlet's shadow correction at the run's
 // step, which together close the balance of linear elasticity at any step (docs/theory.md#energy,
-// decisions.md#d30). A coupled step keeps the balance it had (its supports hold still, and the
-// coupling's own invariant is tested apart).
+// decisions.md#d30). A coupled step counts its continuum's work too (its supports move a coupled
+// DCB's arms) but keeps its own shadow term, which the coupling's invariant is tested with apart.
 std::pair<double, double> continuum_balance_terms(const Scene& scene) {
-  if (!scene.continuum || scene.model->monitor() || scene.static_only()) return {0.0, 0.0};
+  if (!scene.continuum || scene.static_only()) return {0.0, 0.0};
+  if (scene.model->monitor()) return {scene.continuum->external_work(), 0.0};
   return {scene.continuum->external_work(), scene.continuum->verlet_correction(scene.dt)};
 }
 double seconds_since(Clock::time_point t0) {
@@ -596,7 +596,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       }
       if (n % 50 == 0 || n == total_steps)
         model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
-                                    std::abs(model.external_work())) +
+                                    std::abs(model.external_work() + continuum_balance_terms(scene).first)) +
                            1e-300);
       if (output_after(n)) write_outputs();
       if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {

@@ -379,13 +379,11 @@ void ContinuumSolver::drift(double dt) {
   }
 }
 
-void ContinuumSolver::step(double dt) {
-  // The work of the tractions and of the supports over the step (external_work()). The
-  // tractions' term takes a pass over every dof and is made only when there are tractions; the
-  // supports' only over the prescribed dofs.
-  const bool tractions = !tractions_.empty();
-  double work = 0.0;
-  if (tractions) {
+void ContinuumSolver::begin_step_work() {
+  // The tractions' term takes a pass over every dof and is made only when there are tractions;
+  // the supports' only over the prescribed dofs.
+  step_work_ = 0.0;
+  if (!tractions_.empty()) {
     step_u_ = u_;
     step_f_ext_.assign(u_.size(), 0.0);
     add_external_force(step_f_ext_);
@@ -394,24 +392,32 @@ void ContinuumSolver::step(double dt) {
   step_f_fixed_.resize(fixed_.size());
   for (std::size_t k = 0; k < fixed_.size(); ++k) {
     const int d = fixed_[k].dof;
-    work -= 0.5 * mass_[d / 3] * v_[d] * v_[d];
+    step_work_ -= 0.5 * mass_[d / 3] * v_[d] * v_[d];
     step_fixed_u_[k] = u_[d];
     step_f_fixed_[k] = f_[d];
   }
+}
+
+void ContinuumSolver::end_step_work() {
+  if (!tractions_.empty()) {
+    step_f_ext_new_.assign(u_.size(), 0.0);
+    add_external_force(step_f_ext_new_);
+    for (std::size_t d = 0; d < u_.size(); ++d) step_work_ += 0.5 * (step_f_ext_[d] + step_f_ext_new_[d]) * (u_[d] - step_u_[d]);
+  }
+  for (std::size_t k = 0; k < fixed_.size(); ++k) {
+    const int d = fixed_[k].dof;
+    step_work_ += 0.5 * mass_[d / 3] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_fixed_u_[k]);
+  }
+  external_work_ += step_work_;
+}
+
+void ContinuumSolver::step(double dt) {
+  begin_step_work();
   kick(0.5 * dt);
   drift(dt);
   compute_forces();
   kick(0.5 * dt);
-  if (tractions) {
-    step_f_ext_new_.assign(u_.size(), 0.0);
-    add_external_force(step_f_ext_new_);
-    for (std::size_t d = 0; d < u_.size(); ++d) work += 0.5 * (step_f_ext_[d] + step_f_ext_new_[d]) * (u_[d] - step_u_[d]);
-  }
-  for (std::size_t k = 0; k < fixed_.size(); ++k) {
-    const int d = fixed_[k].dof;
-    work += 0.5 * mass_[d / 3] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_fixed_u_[k]);
-  }
-  external_work_ += work;
+  end_step_work();
   double sum = 0;
   for (double v : v_) sum += v;
   if (!std::isfinite(sum)) throw RunError("continuum: non-finite state at t = " + std::to_string(t_));

@@ -123,10 +123,14 @@ class ContinuumSolver {
   void drift(double dt);  // u += dt v on free components; t += dt; fixed ones follow g
   // One velocity-Verlet step; it also adds the step's external work (external_work()).
   void step(double dt);
+  // The external work of one step, for a step made of the parts above (a coupled step):
+  // begin_step_work() before its first kick, end_step_work() after its last (step() calls both).
+  void begin_step_work();
+  void end_step_work();
   double critical_time_step() const;
 
-  // Work done on the continuum by its tractions and its moving supports over the steps of
-  // step() (not by a coupled step's kick and drift), J: per step, the prescribed dofs' kinetic
+  // Work done on the continuum by its tractions and its moving supports over the steps between
+  // begin_step_work() and end_step_work() (step(), a coupled step), J: per step, the prescribed dofs' kinetic
   // energy change + 1/2 (f_ext + f_ext').du - 1/2 (f + f')_prescribed.du_prescribed, which with
   // verlet_correction() makes the discrete energy balance exact for linear elasticity
   // (docs/theory.md#energy).
@@ -237,8 +241,9 @@ class ContinuumSolver {
   double damping_ = 0.0;         // 1/s
   Field damping_force_;          // N per dof, of the last compute_forces (both half kicks use it)
   double dissipated_ = 0.0;      // J
-  // step()'s scratch: with tractions, u and f_ext at the step's start and f_ext at its end; the
-  // prescribed dofs' u and f at the step's start.
+  // A step's work so far and its scratch: with tractions, u and f_ext at the step's start and f_ext
+  // at its end; the prescribed dofs' u and f at the step's start.
+  double step_work_ = 0.0;
   Field step_u_, step_f_ext_, step_f_ext_new_, step_fixed_u_, step_f_fixed_;
 };
 

@@ -163,10 +163,12 @@ Eigen::Map<Matrix3> CoupledModel::continuum_velocity() {
 }
 
 void CoupledModel::step(double dt) {
+  continuum_.begin_step_work();  // its moving supports and tractions (held dofs: no correction)
   constraint_half_kick(dt);
   advance_models(dt);
   kick_to_trial(dt);
   solve_and_correct(dt);
+  continuum_.end_step_work();
   time_ += dt;
   ++steps_;
 }
