@@ -1,34 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The two arms of the coupled DCB (cases/dcb_coupled): x along the beam (0 to L = 45 mm), y across
-// (0 to b = 6 mm), z through the thickness, lower arm 0 to h = 1.5 mm, upper arm h to 2h. The arms
-// are two bodies that share no node: along the pre-crack they are free of each other, beyond it
-// only the DEM band (the cohesive interface) joins them. Each arm is three layers of 0.5 mm glued
-// together, so that the load strips of the end face (x = 0, z in [0.5, 1] mm and [2, 2.5] mm,
-// where cases/dcb drives its load-line DEs) are physical surfaces: "load_bottom", "load_top".
-// Structured (transfinite): 0.5 mm along x and y, 0.25 mm through the thickness (six elements
-// per arm), so node planes lie every 0.25 mm in z, where the band's overlap faces fall for
-// half-thicknesses and widths in steps of 0.25 mm.
-SetFactory("OpenCASCADE");
-L = 45e-3; b = 6e-3; h = 1.5e-3; t = 0.5e-3;
-For k In {0:5}
-  Box(k + 1) = {0, 0, k * t, L, b, t};
-EndFor
-BooleanFragments{ Volume{1, 2, 3}; Delete; }{}
-BooleanFragments{ Volume{4, 5, 6}; Delete; }{}
-e = 1e-7;
-Transfinite Curve {Curve In BoundingBox{-e, -e, -e, L + e, e, 2 * h + e}} = 91;   // along x (y = 0 face)
-Transfinite Curve {Curve In BoundingBox{-e, b - e, -e, L + e, b + e, 2 * h + e}} = 91;
-Transfinite Curve {Curve In BoundingBox{-e, -e, -e, e, b + e, 2 * h + e}} = 3;    // x = 0 face: z edges, then y edges
-Transfinite Curve {Curve In BoundingBox{L - e, -e, -e, L + e, b + e, 2 * h + e}} = 3;
-For k In {0:6}
-  Transfinite Curve {Curve In BoundingBox{-e, -e, k * t - e, e, b + e, k * t + e}} = 13;
-  Transfinite Curve {Curve In BoundingBox{L - e, -e, k * t - e, L + e, b + e, k * t + e}} = 13;
-  Transfinite Curve {Curve In BoundingBox{-e, -e, k * t - e, L + e, e, k * t + e}} = 91;
-  Transfinite Curve {Curve In BoundingBox{-e, b - e, k * t - e, L + e, b + e, k * t + e}} = 91;
-EndFor
-Transfinite Surface {:};
-Transfinite Volume {:};
-Physical Surface("load_bottom") = {Surface In BoundingBox{-e, -e, t - e, e, b + e, 2 * t + e}};
-Physical Surface("load_top") = {Surface In BoundingBox{-e, -e, 4 * t - e, e, b + e, 5 * t + e}};
-Physical Volume("lower") = {Volume In BoundingBox{-e, -e, -e, L + e, b + e, h + e}};
-Physical Volume("upper") = {Volume In BoundingBox{-e, -e, h - e, L + e, b + e, 2 * h + e}};
+// The coupled DCB's arms (cases/dcb_coupled; layout in dcb_arms_layout.geo): 0.5 mm along x and y,
+// 0.25 mm through the thickness (six elements per arm), so node planes lie every 0.25 mm in z,
+// where the band's overlap faces fall for half-thicknesses and widths in steps of 0.25 mm.
+nx = 91; ny = 13; nz = 3;
+Include "dcb_arms_layout.geo";

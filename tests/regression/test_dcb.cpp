@@ -14,6 +14,7 @@
 #include <vector>
 #include <string>
 
+#include "common/json.hpp"
 #include "support/cli.hpp"
 
 namespace arlequin {
@@ -208,6 +209,67 @@ TEST(Dcb, ReducedDcbPropagatesAlongLefmAndBalancesEnergy) {
     mix += std::stod(e.at("mode_mix"));
   }
   EXPECT_LT(mix / breaks.size(), 0.45);  // opening-dominated: measured 0.33 (the arms' rotation slides the faces)
+}
+
+// The coupled DCB (cases/dcb_coupled) on the reduced DCB's packing (radius 2.8e-4 m) and the
+// coarse arms (meshes/dcb_arms_coarse.geo), band half-thickness 1 mm and overlap 0.5 mm, to
+// Delta = 1.1 mm: the crack runs through the band while the coupling's bookkeeping holds. Its
+// P(Delta) is not judged here: these arms are two and three elements thick and these DEs soft,
+// and the comparison with the pure-DEM DCB is the 40k one (cases/dcb_coupled/README.md).
+const std::string coupled_case = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/dcb_coupled/case.yaml";
+const std::string reduced_coupled =
+    " --quiet --set dem.sample.radius.mean=2.8e-4 --set dem.sample.file=../dcb/results/dcb_reduced/sample.h5"
+    " --set continuum.mesh.file=../../meshes/dcb_arms_coarse.geo --set coupling.overlap.band.half_thickness=1.0e-3"
+    " --set coupling.overlap.band.width=5.0e-4 --set output.every=2.0e-5 --set output.fields=[] --set checks=[]";
+
+TEST(Dcb, ReducedCoupledDcbBalancesEnergyAndKeepsItsDamageInTheBand) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("dcb_coupled_reduced");
+  // on_damage_in_overlap: stop (the case's): a break where the coupling weights the bonds ends the run with exit 3.
+  const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled + " --set time.end=1.2e-3 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = test::read_csv(out / "series.csv");
+  ASSERT_GT(rows.size(), 50u);
+  double work = 0.0, balance = 0.0, coupling = 0.0;
+  for (const auto& row : rows) {
+    work = std::max(work, at(row, "W_external"));
+    balance = std::max(balance, std::abs(at(row, "E_balance")));
+    coupling = std::max(coupling, std::abs(at(row, "W_coupling")));
+  }
+  // The work of the continuum's moving load strips is all the work put in; the balance closes to
+  // O((omega dt)^2) of it with the breaks' energy released within a step: measured 1.5e-6.
+  EXPECT_GT(work, 0.05);  // measured 0.086 J
+  EXPECT_LT(balance, 5e-6 * work);
+  // The multiplier forces do no work (RATTLE on a linear constraint): round-off, measured 1.0e-15.
+  EXPECT_LT(coupling, 1e-12 * work);
+  // The crack has run through the band (tip beyond a0 = 13.5 mm: measured 24.0 mm) and its links
+  // dissipated G_I b per length of crack and what the process zone ahead of the tip holds
+  // (measured 1.32 times G_I b (a - a0)).
+  const auto& last = rows.back();
+  EXPECT_GT(at(last, "a"), 0.020);
+  EXPECT_GT(at(last, "E_interface"), 1.1 * G * b * (at(last, "a") - a0));
+  EXPECT_LT(at(last, "E_interface"), 1.6 * G * b * (at(last, "a") - a0));
+}
+
+// The band moved so that the interface lies in its lower overlap: the first cohesive link to fail
+// there is one the coupling weights, and the run stops at once, saying which (docs/theory.md
+// #overlap-damage).
+TEST(Dcb, CoupledDcbStopsWhenTheCrackRunsThroughTheOverlap) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("dcb_coupled_overlap_damage");
+  // The first link there fails at t = 0.61 ms (weight 0.92).
+  const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled +
+                                    " --set coupling.overlap.band.center=2.2e-3 --set time.end=8.0e-4 --out " + out.string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("damage reached the coupling overlap: bond"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("of 'interface'"), std::string::npos) << r.output;
+  const Json summary = Json::parse(test::read_text(out / "summary.json"));
+  EXPECT_EQ(summary.at("status").get<std::string>(), "failed");
+  EXPECT_GE(summary.at("damage_in_overlap_breaks").get<int>(), 1);
 }
 
 // The 40k-DE DCB of the case file, to Delta = 2.5 mm: R5's gates as restated (docs/decisions.md#d28).

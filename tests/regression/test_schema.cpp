@@ -95,6 +95,11 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
             dir_);
   read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
   read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
+  read_case(cases + "dcb_coupled/case.yaml",  // its band overlap, on the DCB's packing above
+            {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
+             "continuum.mesh.file=../../meshes/dcb_arms_coarse.geo", "coupling.overlap.band.half_thickness=1.0e-3",
+             "coupling.overlap.band.width=5.0e-4"},
+            dir_);
 
   std::ofstream(dir_ / "des.csv") << "x,y,z,radius\n0,0,0,0.001\n0.002,0,0,0.001\n";
   std::ofstream(dir_ / "table.yaml") << "time: {end: 1.0e-6, dt: 1.0e-8}\ndem:\n  density: 7800\n"
