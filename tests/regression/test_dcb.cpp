@@ -261,7 +261,7 @@ TEST(Dcb, CoupledDcbStopsWhenTheCrackRunsThroughTheOverlap) {
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("dcb_coupled_overlap_damage");
-  // The first link there fails at t = 0.61 ms (weight 0.92).
+  // The first link there fails at t = 0.60 ms (weight 0.92).
   const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled +
                                     " --set coupling.overlap.band.center=2.2e-3 --set time.end=8.0e-4 --out " + out.string());
   EXPECT_EQ(r.exit_code, 3) << r.output;
