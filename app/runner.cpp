@@ -498,18 +498,12 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       throw InputError(file + " is at step " + std::to_string(steps_done) + (steps_done == scene.steps ? ", the last" : ", past the last") +
                        " of this case (time.end " + std::to_string(scene.end_time) + " s): give a later time.end to continue it");
     if (total_steps <= steps_done)
-      throw InputError("--steps " + std::to_string(total_steps) + ": the run stops at or before " + file + "'s step " +
-                       std::to_string(steps_done) + ", where it restarts");
+      throw InputError("--steps " + std::to_string(total_steps) + ": the run would stop at or before step " +
+                       std::to_string(steps_done) + ", where " + file + " restarts it");
     next_checkpoint = steps_done * scene.dt + checkpoint_every;  // the case's interval, from here
     load_scene_state(scene, *restart, options.restart_file);
   }
-  std::optional<Outputs> outputs_or;
-  try {
-    outputs_or.emplace(scene, run_id, restart, options.restart_file.parent_path());
-  } catch (const StateMismatch& e) {
-    throw InputError("'" + options.restart_file.string() + "' is not a checkpoint of this scene: " + e.what());
-  }
-  Outputs& outputs = *outputs_or;
+  Outputs outputs(scene, run_id, restart, options.restart_file.parent_path());
   // The runner's part of the checkpoint: where the run is, its output schedule, the scales its
   // checks use, and what it has reported; the rows and frames are the outputs'.
   std::string checkpoint_error;  // the first checkpoint that could not be written

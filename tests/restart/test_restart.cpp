@@ -230,7 +230,7 @@ TEST(RestartRefusal, AnotherCaseNamesTheKeyButTimeEndAndOutputMayChange) {
   expect_refused(" --restart " + file.string() + " --set dem.bond.sigma_f=1.9e8", "'dem.bond.sigma_f' differs");
   expect_refused(" --restart " + file.string() + " --set time.end=3.0e-6", "is at step 200, past the last of this case");
   expect_refused(" --restart " + file.string() + " --set time.end=6.53018845964e-6", "is at step 200, the last of this case");
-  expect_refused(" --restart " + file.string() + " --steps 150", "--steps 150: the run stops at or before");
+  expect_refused(" --restart " + file.string() + " --steps 150", "--steps 150: the run would stop at or before step 200");
   const auto r = test::run_arlequin("run " + lattice + " --quiet --out " + test::scratch_path("restart_refusal_case").string() +
                                     " --restart " + file.string() + " --steps 300 --set time.end=4.0e-4 --set output.every=4.0e-6");
   EXPECT_EQ(r.exit_code, 0) << r.output;
