@@ -16,21 +16,24 @@ std::string text_of(const YAML::Node& node) {
   return out.c_str();
 }
 
-// First path under `at` where a and b differ ("" if none); `ignored` paths are skipped.
+// What a restart may change (docs/restart.md).
+bool free_to_change(const std::string& path) { return path == "time.end" || path == "output"; }
+
+// First path under `at` where a and b differ ("" if none), skipping what is free to change.
 std::string first_difference(const YAML::Node& a, const YAML::Node& b, const std::string& at) {
-  if (at == "time.end" || at == "output") return "";
+  if (free_to_change(at)) return "";
   if (a.IsMap() && b.IsMap()) {
     for (const auto& entry : a) {
       const std::string key = entry.first.as<std::string>(), path = at.empty() ? key : at + "." + key;
       if (!b[key]) {
-        if (path == "time.end" || path == "output") continue;
+        if (free_to_change(path)) continue;
         return path;
       }
       if (const std::string d = first_difference(entry.second, b[key], path); !d.empty()) return d;
     }
     for (const auto& entry : b) {
       const std::string key = entry.first.as<std::string>(), path = at.empty() ? key : at + "." + key;
-      if (!a[key] && !(path == "time.end" || path == "output")) return path;
+      if (!a[key] && !free_to_change(path)) return path;
     }
     return "";
   }

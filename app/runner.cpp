@@ -31,14 +31,23 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The continuum's own terms of the energy balance: its tractions' and supports' work, and velocity Verlet's shadow correction at the run's
-// step, which together close the balance of linear elasticity at any step (docs/theory.md#energy,
-// decisions.md#d30). A coupled step counts its continuum's work too (its supports move a coupled
-// DCB's arms) but keeps its own shadow term, which the coupling's invariant is tested with apart.
+// The continuum's own terms of the energy balance: its tractions' and supports' work, and
+// velocity Verlet's shadow correction at the run's step, which together close the balance of
+// linear elasticity at any step (docs/theory.md#energy, decisions.md#d30). A coupled step counts
+// its continuum's work too (its supports move a coupled DCB's arms) but keeps its own shadow
+// term, which the coupling's invariant is tested with apart.
+double continuum_work(const Scene& scene) {
+  return scene.continuum && !scene.static_only() ? scene.continuum->external_work() : 0.0;
+}
 std::pair<double, double> continuum_balance_terms(const Scene& scene) {
-  if (!scene.continuum || scene.static_only()) return {0.0, 0.0};
-  if (scene.model->monitor()) return {scene.continuum->external_work(), 0.0};
-  return {scene.continuum->external_work(), scene.continuum->verlet_correction(scene.dt)};
+  if (!scene.continuum || scene.static_only() || scene.model->monitor()) return {continuum_work(scene), 0.0};
+  return {continuum_work(scene), scene.continuum->verlet_correction(scene.dt)};
+}
+// series.csv's header as one text ("time,step,...,"), which a checkpoint holds to be recognised.
+std::string column_list(const std::vector<std::string>& columns) {
+  std::string list;
+  for (const auto& c : columns) list += c + ",";
+  return list;
 }
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -102,9 +111,7 @@ class Outputs {
 
   // Those rows and the frames' index, for the checkpoint.
   void save_state(StateArchive& archive) const {
-    std::string columns;
-    for (const auto& c : series_->columns()) columns += c + ",";
-    archive.put_text("run/series_columns", columns);
+    archive.put_text("run/series_columns", column_list(series_->columns()));
     std::vector<double> rows;
     for (std::size_t r = 0; r < rows_on_schedule_; ++r) rows.insert(rows.end(), series_->row(r).begin(), series_->row(r).end());
     archive.put("run/series", rows);
@@ -476,16 +483,14 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       next_frame = restart->number("run/next_frame");
       initial_total = restart->number("run/initial_total");
       energy_scale = restart->number("run/energy_scale");
-      std::string columns;
-      for (const auto& c : series_columns(scene)) columns += c + ",";
+      const auto names = series_columns(scene);
+      const std::string columns = column_list(names);
       if (restart->text("run/series_columns") != columns)
         throw StateMismatch("its series.csv has the columns '" + restart->text("run/series_columns") + "', this scene '" + columns + "'");
-      if (restart->get<double>("run/series").size() % series_columns(scene).size() != 0)
-        throw StateMismatch("its series rows are not whole rows");
+      if (restart->get<double>("run/series").size() % names.size() != 0) throw StateMismatch("its series rows are not whole rows");
       const auto frame_times = restart->get<double>("run/frame_times");
       if (static_cast<std::int64_t>(frame_times.size()) != restart->integer("run/frames") || !restart->has("run/frames_index"))
         throw StateMismatch("its frame count and frame times disagree");
-      const auto names = series_columns(scene);
       const auto sensors = restart->get<double>("run/sensors");
       for (std::size_t k = 0; k < sensors.size() && k + 2 < names.size(); ++k) result.sensors.emplace_back(names[k + 2], sensors[k]);
       result.damage_in_overlap = restart->text("run/damage_in_overlap");
@@ -590,7 +595,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       }
       if (n % 50 == 0 || n == total_steps)
         model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
-                                    std::abs(model.external_work() + continuum_balance_terms(scene).first)) +
+                                    std::abs(model.external_work() + continuum_work(scene))) +
                            1e-300);
       if (output_after(n)) write_outputs();
       if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {

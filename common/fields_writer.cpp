@@ -92,6 +92,15 @@ void replace_all(std::string& text, const std::string& from, const std::string& 
 // Stands for the HDF5 file's name in frames_index(): a control character, which no XML holds.
 constexpr const char* file_token = "\x1f:";
 
+// Frame k's group in the HDF5 file, "/frames/000042".
+std::string frame_group(std::size_t k) {
+  char path[32];
+  std::snprintf(path, sizeof path, "/frames/%06zu", k);
+  return path;
+}
+// How each frame's XDMF starts (finish_frame), which frames_index() counts.
+constexpr const char* frame_grid_start = "<Grid Name=\"frame_";
+
 void check_name(std::string_view kind, const std::string& name) {
   if (name.empty() || name.find('/') != std::string::npos)
     throw std::logic_error("FieldsWriter: bad " + std::string(kind) + " name '" + name + "'");
@@ -145,8 +154,8 @@ FieldsWriter::~FieldsWriter() {
 void FieldsWriter::begin_frame(double time) {
   if (file_ < 0) throw std::logic_error("FieldsWriter::begin_frame: writer is closed");
   if (in_frame_) throw std::logic_error("FieldsWriter::begin_frame: previous frame not ended");
-  char path[32];
-  std::snprintf(path, sizeof path, "/frames/%06zu", frame_count_);
+  const std::string group_path = frame_group(frame_count_);
+  const char* path = group_path.c_str();
   const Handle group(checked(H5Gcreate2(file_, path, intermediate_groups(part_path_, path), H5P_DEFAULT, H5P_DEFAULT),
                              part_path_, "create group", path),
                      H5Gclose);
@@ -187,7 +196,7 @@ std::string FieldsWriter::frames_index(std::size_t frames) const {
   // Each frame's XDMF starts with its collection grid (finish_frame).
   std::size_t end = 0;
   for (std::size_t k = 0; k <= frames && end != std::string::npos; ++k)
-    end = frames_xml_.find("<Grid Name=\"frame_", k == 0 ? 0 : end + 1);
+    end = frames_xml_.find(frame_grid_start, k == 0 ? 0 : end + 1);
   std::string index = frames_xml_.substr(0, end);
   replace_all(index, h5_reference_ + ":", file_token);
   return index;
@@ -214,8 +223,8 @@ void FieldsWriter::carry_frames(const std::filesystem::path& earlier, std::uint6
     throw RunError("'" + earlier.string() + "' holds another run's frames");
   try {
     for (std::size_t k = 0; k < times.size(); ++k) {
-      char path[32];
-      std::snprintf(path, sizeof path, "/frames/%06zu", k);
+      const std::string group = frame_group(k);
+      const char* path = group.c_str();
       double time = 0.0;
       if (H5Lexists(source, "/frames", H5P_DEFAULT) <= 0 || H5Lexists(source, path, H5P_DEFAULT) <= 0 ||
           H5Aexists_by_name(source, path, "time", H5P_DEFAULT) <= 0)
@@ -368,7 +377,7 @@ std::string FieldsWriter::write_dataset(const std::string& path, const Column& c
 
 void FieldsWriter::finish_frame() {
   in_frame_ = false;
-  std::string xml = "<Grid Name=\"frame_" + frame_path_.substr(frame_path_.rfind('/') + 1) +
+  std::string xml = frame_grid_start + frame_path_.substr(frame_path_.rfind('/') + 1) +
                     "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n<Time Value=\"" +
                     number_text(frame_time_) + "\"/>\n";
   for (const Grid& grid : grids_)
