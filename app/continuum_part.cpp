@@ -26,6 +26,8 @@ constexpr KeyDoc continuum_keys[] = {
     {"mesh", KeyType::section, "", {}, "", "the gmsh mesh"},
     {"material", KeyType::section, "", {}, "", "the elastic material"},
     {"analysis", KeyType::choice, "", {}, "explicit", "explicit dynamics, or one static solve", "explicit | static"},
+    {"kinematics", KeyType::choice, "", {}, "small",
+     "small strains and rotations, or finite: total Lagrangian, rotations of any size (explicit only)", "small | finite"},
     {"shape_functions", KeyType::choice, "", {}, "sibson", "nem: natural-neighbour interpolant", "sibson | laplace"},
     {"stabilization", KeyType::number, "1", Range::positive(), "1", "nem: weight of the SCNI stabilisation term"},
     {"petsc_options", KeyType::string, "", {}, "", "PETSc options of the static solve (e.g. -ksp_type cg -pc_type gamg)"},
@@ -206,6 +208,10 @@ ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_
   out.solver.petsc_options = own_options + " " + extra_petsc_options;
   static constexpr std::string_view analyses[] = {"explicit", "static"};
   out.is_static = section.choice_or("analysis", "explicit", analyses) == "static";
+  static constexpr std::string_view kinematics[] = {"small", "finite"};
+  out.solver.kinematics = continuum::kinematics_from_name(section.choice_or("kinematics", "small", kinematics));
+  if (out.is_static && out.solver.kinematics == continuum::Kinematics::finite)
+    section.fail("kinematics", "finite is for analysis: explicit (the static solve is linear)");
   out.damping = section.number_or("damping", 0.0, Range::non_negative(), "1/s");
   if (out.is_static && out.damping > 0.0) section.fail("damping", "is for analysis: explicit (a static solve has no velocity)");
   // Options that nothing reads are an error, not silence: the explicit step solves nothing.

@@ -69,7 +69,16 @@ void ContinuumSolver::check_static_solver_options(const std::string& petsc_optio
   MatDestroy(&A);
 }
 
-ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings) : mesh_(Mesh::load(settings.mesh)) {
+Kinematics kinematics_from_name(const std::string& name) {
+  if (name == "small") return Kinematics::small;
+  if (name == "finite") return Kinematics::finite;
+  throw InputError("unknown kinematics '" + name + "' (known: small, finite)");
+}
+
+const char* kinematics_name(Kinematics k) { return k == Kinematics::small ? "small" : "finite"; }
+
+ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings)
+    : mesh_(Mesh::load(settings.mesh)), kinematics_(settings.kinematics) {
   PetscSession::ensure(settings.petsc_options);
   if (settings.materials.empty()) throw InputError("continuum: no material given");
   tet_material_.assign(mesh_.num_tets(), -1);
@@ -300,24 +309,64 @@ ContinuumSolver::SurfaceRule ContinuumSolver::surface_rule(const std::vector<std
   return rule;
 }
 
-Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
-  Voigt e = Voigt::Zero();
+Eigen::Matrix3d ContinuumSolver::displacement_gradient(int q, const Field& u) const {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
   for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
     const Vec3& g = points_.grad[k];
     const double* uj = &u[3 * static_cast<size_t>(points_.node[k])];
-    e[0] += g.x * uj[0];
-    e[1] += g.y * uj[1];
-    e[2] += g.z * uj[2];
-    e[3] += g.z * uj[1] + g.y * uj[2];
-    e[4] += g.z * uj[0] + g.x * uj[2];
-    e[5] += g.y * uj[0] + g.x * uj[1];
+    for (int i = 0; i < 3; ++i) H.row(i) += uj[i] * Eigen::RowVector3d(g.x, g.y, g.z);
   }
-  return e;
+  return H;
+}
+
+namespace {
+
+// A symmetric strain tensor in Voigt order (xx, yy, zz, yz, xz, xy), engineering shears.
+Voigt voigt_strain(const Eigen::Matrix3d& e) {
+  Voigt v;
+  v << e(0, 0), e(1, 1), e(2, 2), 2.0 * e(1, 2), 2.0 * e(0, 2), 2.0 * e(0, 1);
+  return v;
+}
+
+// Green-Lagrange E = (H + H^T + H^T H) / 2, or the small strain (H + H^T) / 2.
+Eigen::Matrix3d strain_tensor(const Eigen::Matrix3d& H, Kinematics k) {
+  const Eigen::Matrix3d linear = 0.5 * (H + H.transpose());
+  return k == Kinematics::small ? linear : Eigen::Matrix3d(linear + 0.5 * H.transpose() * H);
+}
+
+}  // namespace
+
+Voigt ContinuumSolver::strain_at(int q, const Field& u) const {
+  return voigt_strain(strain_tensor(displacement_gradient(q, u), kinematics_));
 }
 
 // f_int = sum_q w_q B_q^T C_q B_q u = K u, K assembled once per weight (block_matrix.hpp says
-// why).
-void ContinuumSolver::internal_force(const Field& u, Field& f_int) const { stiffness().multiply(u, f_int); }
+// why); finite kinematics: the first Piola-Kirchhoff stress P = F S(E) of every point, spread
+// to its nodes as w_q P grad_q N_a (the gradient of the contract's strain energy).
+void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
+  if (kinematics_ == Kinematics::small) {
+    stiffness().multiply(u, f_int);
+    return;
+  }
+  finite_internal_force(u, f_int);
+}
+
+void ContinuumSolver::finite_internal_force(const Field& u, Field& f_int) const {
+  f_int.assign(u.size(), 0.0);
+  for (int q = 0; q + 1 < static_cast<int>(points_.offset.size()); ++q) {
+    const Eigen::Matrix3d H = displacement_gradient(q, u);
+    const Voigt s = materials_[points_.material[q]].C * voigt_strain(strain_tensor(H, Kinematics::finite));
+    Eigen::Matrix3d S;
+    S << s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2];
+    const Eigen::Matrix3d wP = point_weight_[q] * (Eigen::Matrix3d::Identity() + H) * S;
+    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
+      const Vec3& g = points_.grad[k];
+      const Eigen::Vector3d fa = wP * Eigen::Vector3d(g.x, g.y, g.z);
+      double* fj = &f_int[3 * static_cast<size_t>(points_.node[k])];
+      fj[0] += fa[0], fj[1] += fa[1], fj[2] += fa[2];
+    }
+  }
+}
 
 void ContinuumSolver::add_external_force(Field& f) const {
   for (const Traction& tr : tractions_) {
@@ -474,7 +523,7 @@ double ContinuumSolver::critical_time_step() const {
     for (double xi : x) nx += xi * xi;
     nx = std::sqrt(nx);
     for (size_t d = 0; d < n; ++d) scaled[d] = x[d] / nx / std::sqrt(mass_[d / 3]);
-    internal_force(scaled, y);
+    stiffness().multiply(scaled, y);
     double rq = 0;
     for (size_t d = 0; d < n; ++d) {
       y[d] /= std::sqrt(mass_[d / 3]);
@@ -494,6 +543,8 @@ double ContinuumSolver::critical_time_step() const {
 // [r nq / size, (r + 1) nq / size), and entries of rows owned elsewhere travel in PETSc's stash at
 // MatAssemblyBegin/End. Without mpirun there is one rank and this is a sequential solve.
 void ContinuumSolver::solve_static(const std::string& petsc_options) {
+  if (kinematics_ == Kinematics::finite)
+    throw InputError("continuum: the static solve is linear (kinematics: small); finite kinematics are for explicit runs");
   const MPI_Comm comm = PETSC_COMM_WORLD;
   PetscMPIInt rank, size;  // MPI errors abort (MPI_ERRORS_ARE_FATAL): no codes to check
   MPI_Comm_rank(comm, &rank);
@@ -615,7 +666,15 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
 }
 
 double ContinuumSolver::strain_energy() const {
-  internal_force(u_, ku_);
+  if (kinematics_ == Kinematics::finite) {
+    double e = 0.0;
+    for (size_t q = 0; q < points_.x.size(); ++q) {
+      const Voigt E = strain_at(static_cast<int>(q), u_);
+      e += 0.5 * point_weight_[q] * E.dot(materials_[points_.material[q]].C * E);
+    }
+    return e;
+  }
+  stiffness().multiply(u_, ku_);
   double e = 0;
   for (size_t d = 0; d < u_.size(); ++d) e += u_[d] * ku_[d];
   return 0.5 * e;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// ContinuumSolver: one linear-elastic continuum on a gmsh mesh, discretised by a named method
-// (see registry.hpp). Everything the coupling and the application use is here; a method only
+// ContinuumSolver: one elastic continuum on a gmsh mesh, discretised by a named method (see
+// registry.hpp). Everything the coupling and the application use is here; a method only
 // supplies its integration points, its lumped mass and its interpolation.
 //
 // Contract
@@ -8,10 +8,16 @@
 //    node, node-major (x0, y0, z0, x1, ...).
 //  - Weight alpha(x) (Arlequin, default 1) multiplies every volume integrand: the lumped mass,
 //    the internal force, the stiffness and the strain energy. The caller applies any mass floor.
-//  - Strain at integration point q is B_q u (constant per point); forces and energies are sums
-//    over points: f_int = sum_q w_q B_q^T C_q B_q u = K u, E_strain = 1/2 sum_q w_q
-//    eps_q.C_q eps_q = 1/2 u.K u, with w_q = alpha(x_q) |cell_q|. K is assembled once per
-//    weight (a BlockMatrix3), so a step and an energy cost one pass over K's blocks.
+//  - Kinematics (docs/theory.md#finite-kinematics): forces and energies are sums over points,
+//    w_q = alpha(x_q) |cell_q|, with H_q = sum_a u_a (x) grad_q N_a the displacement gradient at q.
+//      small:  eps_q = sym(H_q) = B_q u, f_int = sum_q w_q B_q^T C_q B_q u = K u,
+//              E_strain = 1/2 sum_q w_q eps_q.C_q eps_q = 1/2 u.K u. K is assembled once per
+//              weight (a BlockMatrix3), so a step and an energy cost one pass over K's blocks.
+//      finite: total Lagrangian St Venant-Kirchhoff: F = I + H_q, Green-Lagrange
+//              E_q = (H + H^T + H^T H) / 2, S_q = C_q E_q, f_int,a = sum_q w_q F_q S_q grad_q N_a,
+//              E_strain = 1/2 sum_q w_q E_q.C_q E_q. A rigid rotation of any size strains nothing,
+//              as a DEM's bonds see it; the material law is meant for small strains.
+//    critical_time_step() and solve_static() use K (the tangent at the undeformed state).
 //  - `interpolation(points)` returns the sparse operator N (rows: points, columns: nodes) with
 //    u(point_p) = sum_I N(p, I) u_I per component; points outside the body are an InputError.
 //  - Essential BCs act on named physical groups and fix chosen components to g(X, t); loads are
@@ -51,8 +57,14 @@ struct RegionMaterial {
   Material material;
 };
 
+// The strain measure (contract above).
+enum class Kinematics { small, finite };
+Kinematics kinematics_from_name(const std::string& name);  // "small" or "finite"; InputError otherwise
+const char* kinematics_name(Kinematics k);
+
 struct ContinuumSettings {
   MeshSource mesh;
+  Kinematics kinematics = Kinematics::small;
   std::vector<RegionMaterial> materials;
   std::string petsc_options;              // given to PetscSession on the first continuum built
   std::string shape_functions = "sibson";  // nem only: "sibson" or "laplace"
@@ -150,14 +162,18 @@ class ContinuumSolver {
   // unread (checked on a 1 x 1 system, so a case is refused before its run; starts PETSc).
   static void check_static_solver_options(const std::string& petsc_options);
 
+  Kinematics kinematics() const { return kinematics_; }
+  // f_int(u) of the solver's kinematics; K u for small ones.
   void internal_force(const Field& u, Field& f_int) const;
-  // 1/2 u.K u: one pass over K. A rigid part of u cancels to round-off eps |K| |u|^2 (the point
-  // sum's was second order in eps); far below the energies of these cases, but a state with a
-  // rigid motion 1e6 times its strains would see it.
+  // Small kinematics: 1/2 u.K u, one pass over K. A rigid part of u cancels to round-off
+  // eps |K| |u|^2 (the point sum's was second order in eps); far below the energies of these
+  // cases, but a state with a rigid motion 1e6 times its strains would see it. Finite: the
+  // point sum of the contract.
   double strain_energy() const;
   double kinetic_energy() const;
 
-  // Integration points, for output and checks: positions and strain / stress (Voigt).
+  // Integration points, for output and checks: positions and strain / stress (Voigt): small
+  // strain and Cauchy stress, or (finite) Green-Lagrange strain and second Piola-Kirchhoff stress.
   const std::vector<Vec3>& point_positions() const { return points_.x; }
   const std::vector<double>& point_weights() const { return point_weight_; }  // alpha(x_q) |cell_q|, m^3
   std::vector<Voigt> point_strain() const;
@@ -205,7 +221,10 @@ class ContinuumSolver {
     VectorFunction g;
     double start = 0.0;  // the initial displacement of the dof, m
   };
-  Voigt strain_at(int q, const Field& u) const;
+  // H_q = sum_a u_a (x) grad_q N_a (row: displacement component, column: derivative).
+  Eigen::Matrix3d displacement_gradient(int q, const Field& u) const;
+  Voigt strain_at(int q, const Field& u) const;  // the kinematics' strain, engineering shears
+  void finite_internal_force(const Field& u, Field& f_int) const;
   void add_external_force(Field& f) const;
   double prescribed(const Fixed& f, double t) const;
 
@@ -222,6 +241,7 @@ class ContinuumSolver {
   Eigen::VectorXd weights_meeting_targets(const std::vector<int>& points, const Eigen::VectorXd& w0,
                                           const std::vector<int>& row, int rows, const std::vector<Vec3>& target) const;
 
+  Kinematics kinematics_;
   ScalarFunction alpha_;
   std::vector<double> point_weight_;  // alpha(x_q) volume_q
   // stiffness()'s K and whether it is that of the current weights; strain_energy()'s K u. Kept
