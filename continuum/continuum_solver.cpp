@@ -104,7 +104,13 @@ ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings)
 
 ContinuumSolver::~ContinuumSolver() = default;
 
-void ContinuumSolver::finish_setup() { set_weight([](const Vec3&) { return 1.0; }); }
+void ContinuumSolver::finish_setup() {
+  set_weight([](const Vec3&) { return 1.0; });
+  if (kinematics_ == Kinematics::small) return;
+  std::vector<Stiffness> stiffness;
+  for (const Material& m : materials_) stiffness.push_back(m.C);
+  finite_force_ = FiniteStrainForce(points_.offset, points_.node, points_.grad, points_.material, stiffness);
+}
 
 void ContinuumSolver::set_weight(ScalarFunction alpha) {
   alpha_ = std::move(alpha);
@@ -348,25 +354,9 @@ void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
     stiffness().multiply(u, f_int);
     return;
   }
-  finite_internal_force(u, f_int);
+  finite_force_.compute(u, point_weight_, f_int);
 }
 
-void ContinuumSolver::finite_internal_force(const Field& u, Field& f_int) const {
-  f_int.assign(u.size(), 0.0);
-  for (int q = 0; q + 1 < static_cast<int>(points_.offset.size()); ++q) {
-    const Eigen::Matrix3d H = displacement_gradient(q, u);
-    const Voigt s = materials_[points_.material[q]].C * voigt_strain(strain_tensor(H, Kinematics::finite));
-    Eigen::Matrix3d S;
-    S << s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2];
-    const Eigen::Matrix3d wP = point_weight_[q] * (Eigen::Matrix3d::Identity() + H) * S;
-    for (int k = points_.offset[q]; k < points_.offset[q + 1]; ++k) {
-      const Vec3& g = points_.grad[k];
-      const Eigen::Vector3d fa = wP * Eigen::Vector3d(g.x, g.y, g.z);
-      double* fj = &f_int[3 * static_cast<size_t>(points_.node[k])];
-      fj[0] += fa[0], fj[1] += fa[1], fj[2] += fa[2];
-    }
-  }
-}
 
 void ContinuumSolver::add_external_force(Field& f) const {
   for (const Traction& tr : tractions_) {

@@ -42,6 +42,7 @@
 #include "common/state_archive.hpp"
 #include "common/vec3.hpp"
 #include "continuum/block_matrix.hpp"
+#include "continuum/finite_strain_force.hpp"
 #include "continuum/material.hpp"
 #include "continuum/mesh.hpp"
 
@@ -224,7 +225,6 @@ class ContinuumSolver {
   // H_q = sum_a u_a (x) grad_q N_a (row: displacement component, column: derivative).
   Eigen::Matrix3d displacement_gradient(int q, const Field& u) const;
   Voigt strain_at(int q, const Field& u) const;  // the kinematics' strain, engineering shears
-  void finite_internal_force(const Field& u, Field& f_int) const;
   void add_external_force(Field& f) const;
   double prescribed(const Fixed& f, double t) const;
 
@@ -242,6 +242,7 @@ class ContinuumSolver {
                                           const std::vector<int>& row, int rows, const std::vector<Vec3>& target) const;
 
   Kinematics kinematics_;
+  FiniteStrainForce finite_force_;  // finite kinematics' force (built by finish_setup)
   ScalarFunction alpha_;
   std::vector<double> point_weight_;  // alpha(x_q) volume_q
   // stiffness()'s K and whether it is that of the current weights; strain_energy()'s K u. Kept

@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// FiniteStrainForce: the internal force of finite kinematics (docs/theory.md#finite-kinematics)
+// over a method's integration points,
+//   f_int,a = sum_q w_q F_q S_q grad_q N_a,  F = I + H,  S = C (H + H^T + H^T H) / 2.
+//
+// Contract
+//  - Built once from the points (compressed rows: point q has the nodes node[offset[q] ..
+//    offset[q+1]) with gradients grad[...] and material index material[q] into `stiffness`).
+//  - compute(u, w, f_int) overwrites f_int (3 values per node) with the force for the point
+//    weights w (w_q = alpha(x_q) |cell_q|, read at every call, so weights may change between
+//    calls). Nothing is allocated per call.
+//  - Layout (why a class): the points are grouped into batches of equal node count and material
+//    and stored lane-major (entry k of lane i at k * lanes + i), so that one vectorised pass
+//    computes H, E, S and P of many points at once; their node forces are then added to f_int
+//    in a fixed order. One thread, as the rest of the continuum's step.
+#pragma once
+#include <vector>
+
+#include "common/vec3.hpp"
+#include "continuum/material.hpp"
+
+namespace arlequin::continuum {
+
+class FiniteStrainForce {
+ public:
+  FiniteStrainForce() = default;
+  FiniteStrainForce(const std::vector<int>& offset, const std::vector<int>& node, const std::vector<Vec3>& grad,
+                    const std::vector<int>& material, const std::vector<Stiffness>& stiffness);
+  void compute(const std::vector<double>& u, const std::vector<double>& w, std::vector<double>& f_int) const;
+
+ private:
+  struct Batch {
+    int nodes_per_point = 0;  // m
+    Stiffness C;
+    std::vector<int> point;             // q of each lane
+    std::vector<int> dof;               // [k * lanes + i]: 3 x node of entry k of lane i
+    std::vector<double> gx, gy, gz;     // [k * lanes + i]
+    mutable std::vector<double> force;  // one tile, [(3 k + c) * kTile + t]: w_q (P_q grad N_k)_c
+  };
+  // Lanes are computed a tile at a time, so a tile's node forces are still in cache when they
+  // are added to f_int.
+  static constexpr int kTile = 256;
+  template <int M>
+  static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w);
+  std::vector<Batch> batches_;
+};
+
+}  // namespace arlequin::continuum
