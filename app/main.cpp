@@ -277,11 +277,11 @@ int run(const Arguments& a) {
   for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
   for (const auto& c : r.checks) {
     if (c.check->bounded)
-      std::printf("check %s %s: %.6e within [%.6g, %.6g]: %s\n", c.check->column.c_str(), app::describe(c.check->kind),
+      std::printf("check %s %s: %.6e within [%.6g, %.6g]: %s\n", c.check->column.c_str(), app::describe(*c.check).c_str(),
                   c.value, c.check->at_least, c.check->at_most, c.passed ? "ok" : "FAILED");
     else
       std::printf("check %s %s: %.6e vs %.6e expected (error %.3g %%, tolerance %.3g %%): %s\n", c.check->column.c_str(),
-                  app::describe(c.check->kind), c.value, c.check->expected, 100 * c.relative_error,
+                  app::describe(*c.check).c_str(), c.value, c.check->expected, 100 * c.relative_error,
                   100 * c.check->tolerance, c.passed ? "ok" : "FAILED");
   }
   if (!r.checks_skipped.empty()) std::printf("checks not evaluated: %s\n", r.checks_skipped.c_str());

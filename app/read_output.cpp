@@ -45,8 +45,10 @@ constexpr KeyDoc check_keys[] = {
     {"at_least", KeyType::number, "(column unit; 1 against a reference)", {}, "(none)", "lower bound (instead of expected)"},
     {"note", KeyType::string, "", {}, "", "where the reference comes from, shown with the result"},
     {"reference", KeyType::section, "", {}, "(none)", "a reference curve of the column against 'versus': the check is then the largest relative deviation"},
-    {"versus", KeyType::string, "", {}, "", "with reference: the column the reference curve is a function of"},
-    {"over", KeyType::numbers, "(versus unit)", {}, "(the reference's span)", "with reference: the range [low, high] of versus judged"},
+    {"versus", KeyType::string, "", {}, "(none)",
+     "with reference: the column (or time) the reference curve is a function of; with max or min: the column (or time) 'over' ranges"},
+    {"over", KeyType::numbers, "(versus unit)", {}, "(the reference's span; all rows)",
+     "with reference, or max or min and versus: the range [low, high] of versus judged"},
 };
 constexpr KeyDoc output_keys[] = {
     {"dir", KeyType::string, "", {}, "(results/<name>)", "output folder, relative to the working directory"},
@@ -217,6 +219,7 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
     // The name under `key`, which must be a series column.
     const auto series_column = [&](const char* key) {
       std::string name = c.string(key);
+      if (std::string_view(key) == "versus" && name == "time") return name;  // a function of time, or a range of it
       if (std::find(columns.begin(), columns.end(), name) == columns.end()) {
         std::string known;
         for (const auto& k : columns) known += (known.empty() ? "" : ", ") + k;
@@ -245,6 +248,16 @@ void read_checks(CaseNode root, Scene& scene, const std::vector<std::string>& co
                    : statistic == "max"  ? Check::Kind::maximum
                    : statistic == "min"  ? Check::Kind::minimum
                                          : Check::Kind::final_over_initial;
+      // A maximum or minimum over the rows whose `versus` lies in `over` (e.g. a peak load before
+      // the specimen splits).
+      const bool extremum = check.kind == Check::Kind::maximum || check.kind == Check::Kind::minimum;
+      if (c.has("versus") || c.has("over")) {
+        if (!extremum) c.fail(c.has("versus") ? "versus" : "over", "is read with a reference curve or with statistic: max | min");
+        check.versus = series_column("versus");
+        const auto over = c.numbers("over", Range::any(), "(versus unit)");
+        if (over.size() != 2 || !(over[0] < over[1])) c.fail("over", "expected [low, high] with low < high");
+        check.over_low = over[0], check.over_high = over[1];
+      }
     }
     const char* unit = check.kind == Check::Kind::crossing ? "s" : check.kind == Check::Kind::curve ? "1" : "column unit";
     check.bounded = c.has("at_most") || c.has("at_least");

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <random>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -375,11 +376,17 @@ Json energies_json(const dem::Energies& e) {
 
 double steps_per_second(const RunResult& r) { return r.steps / std::max(r.wall_seconds - r.output_seconds, 1e-9); }
 
-const char* describe(Check::Kind kind) {
-  switch (kind) {
+std::string describe(const Check& check) {
+  switch (check.kind) {
     case Check::Kind::final_value: return "final value";
-    case Check::Kind::maximum: return "maximum";
-    case Check::Kind::minimum: return "minimum";
+    case Check::Kind::maximum:
+    case Check::Kind::minimum: {
+      std::string text = check.kind == Check::Kind::maximum ? "maximum" : "minimum";
+      if (check.versus.empty()) return text;
+      std::ostringstream range;
+      range << " over " << check.versus << " in [" << check.over_low << ", " << check.over_high << "]";
+      return text + range.str();
+    }
     case Check::Kind::final_over_initial: return "final / initial";
     case Check::Kind::crossing: return "crossing time";
     case Check::Kind::curve: return "largest deviation from the reference";
@@ -400,9 +407,15 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
     if (c.kind == Check::Kind::final_value && series.rows() > 0) value = series.row(series.rows() - 1)[col];
     if (c.kind == Check::Kind::final_over_initial && series.rows() > 0)
       value = series.row(series.rows() - 1)[col] / series.row(0)[col];
-    for (std::size_t r = 0; (c.kind == Check::Kind::maximum || c.kind == Check::Kind::minimum) && r < series.rows(); ++r) {
-      const double x = series.row(r)[col];
-      if (r == 0 || (c.kind == Check::Kind::maximum ? x > value : x < value)) value = x;
+    if (c.kind == Check::Kind::maximum || c.kind == Check::Kind::minimum) {
+      const std::size_t versus = std::find(columns.begin(), columns.end(), c.versus) - columns.begin();
+      bool first = true;
+      for (std::size_t r = 0; r < series.rows(); ++r) {
+        if (!c.versus.empty() && !(series.row(r)[versus] >= c.over_low && series.row(r)[versus] <= c.over_high)) continue;
+        const double x = series.row(r)[col];
+        if (first || (c.kind == Check::Kind::maximum ? x > value : x < value)) value = x;
+        first = false;
+      }
     }
     for (std::size_t r = 1; crossing && r < series.rows(); ++r) {
       const double a = series.row(r - 1)[col] - c.threshold, b = series.row(r)[col] - c.threshold;
@@ -674,7 +687,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   for (const auto& c : result.checks) {
     Json j = Json::object();
     j["column"] = c.check->column;
-    j["kind"] = describe(c.check->kind);
+    j["kind"] = describe(*c.check);
     j["value"] = c.value;
     if (c.check->bounded) {
       if (std::isfinite(c.check->at_most)) j["at_most"] = c.check->at_most;

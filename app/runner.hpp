@@ -64,7 +64,7 @@ struct RunResult {
 
 RunResult run_scene(Scene& scene, const RunOptions& options);
 
-const char* describe(Check::Kind kind);  // "final value", "maximum", ...
+std::string describe(const Check& check);  // "final value", "maximum over Delta in [0, 0.002]", ...
 // Steps per second of the time loop without its output (summary.json's and the closing line's).
 double steps_per_second(const RunResult& r);
 

@@ -64,9 +64,10 @@ struct Check {
   double at_most = INFINITY, at_least = -INFINITY;
   bool bounded = false;       // true: passes when at_least <= value <= at_most
   std::string note;           // where the expected value comes from
-  std::string versus;         // curve: the column the reference is a function of
+  std::string versus;         // curve: the column the reference is a function of; maximum,
+                              // minimum: the column over ranges (empty: every row)
   ReferenceCurve reference;   // curve
-  double over_low = 0.0, over_high = 0.0;  // curve: the range of versus judged
+  double over_low = 0.0, over_high = 0.0;  // curve, or maximum / minimum with versus: the range of versus judged
 };
 
 // A PNG plot of series.csv columns written at the end of a run (also a stopped one).

@@ -119,6 +119,36 @@ TEST(Cases, ChecksAreNotJudgedOnARunCutShortBySteps) {
 #endif
 }
 
+// A maximum judged over a range of another column (`versus`, `over`; e.g. a peak load before a
+// specimen splits) against the same maximum taken here from series.csv, and unrestricted: the
+// wave reaches the probe in the run's second half, so the two differ by orders of magnitude.
+TEST(Cases, ExtremumChecksOverARangeOfAnotherColumn) {
+  const auto out = test::scratch_dir("extremum_over");
+  const auto r = test::run_arlequin("run " + cases + "wave_bar_dem/case.yaml --quiet --out " + out.string() +
+                                    " --set output.fields=[] --set \"checks=[{column: u_probe, statistic: max, versus: time, "
+                                    "over: [0, 2.5e-5], at_most: 1, note: first half}, {column: u_probe, statistic: max, "
+                                    "at_most: 1, note: whole run}]\"",
+                                    "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  double first_half = -INFINITY, whole = -INFINITY;
+  for (const auto& row : test::read_csv(out / "series.csv")) {
+    const double u = std::stod(row.at("u_probe"));
+    if (std::stod(row.at("time")) <= 2.5e-5) first_half = std::max(first_half, u);
+    whole = std::max(whole, u);
+  }
+  const Json checks = read_json_file(out / "summary.json").at("checks");
+  EXPECT_NEAR(checks.at(0).at("value").get<double>() / first_half, 1.0, 1e-11);  // series.csv keeps 12 digits
+  EXPECT_NEAR(checks.at(1).at("value").get<double>() / whole, 1.0, 1e-11);
+  EXPECT_LT(first_half, 1e-3 * whole);
+  EXPECT_EQ(checks.at(0).at("kind").get<std::string>(), "maximum over time in [0, 2.5e-05]");
+  // `over` belongs to a reference curve or an extremum.
+  const auto bad = test::run_arlequin("check " + cases + "wave_bar_dem/case.yaml --set \"checks=[{column: u_probe, "
+                                      "versus: time, over: [0, 1], at_most: 1, note: n}]\"");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("checks[0].versus: is read with a reference curve or with statistic: max | min"), std::string::npos)
+      << bad.output;
+}
+
 // compare builds both scenes before it runs either: a bad second case, or two cases with no
 // sensor in common, cost no run. sweep refuses an axis without values.
 TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {

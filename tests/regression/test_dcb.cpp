@@ -222,13 +222,18 @@ const std::string reduced_coupled =
     " --set continuum.mesh.file=../../meshes/dcb_arms_coarse.geo --set coupling.overlap.band.half_thickness=1.0e-3"
     " --set coupling.overlap.band.width=5.0e-4 --set output.every=2.0e-5 --set output.fields=[] --set checks=[]";
 
+// The reduced coupled DCB with `overrides`, its outputs into `out`.
+test::CliResult run_reduced_coupled(const std::filesystem::path& out, const std::string& overrides) {
+  return test::run_arlequin("run " + coupled_case + reduced_coupled + " " + overrides + " --out " + out.string());
+}
+
 TEST(Dcb, ReducedCoupledDcbBalancesEnergyAndKeepsItsDamageInTheBand) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("dcb_coupled_reduced");
   // on_damage_in_overlap: stop (the case's): a break where the coupling weights the bonds ends the run with exit 3.
-  const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled + " --set time.end=1.2e-3 --out " + out.string());
+  const auto r = run_reduced_coupled(out, "--set time.end=1.2e-3");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto rows = test::read_csv(out / "series.csv");
   ASSERT_GT(rows.size(), 50u);
@@ -266,10 +271,9 @@ TEST(Dcb, ReducedCoupledArmsOpenLinearlyUnderFiniteRotations) {
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("dcb_coupled_finite_rotation");
-  const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled +
-                                    " --set dem.interface.bond.precrack.box=[[-1,-1,-1],[0.030,1,1]]"
-                                    " --set dem.interface.bond.sigma_max=1.0e9 --set dem.interface.bond.G_I=1.0e6"
-                                    " --set time.end=1.1e-3 --out " + out.string());
+  const auto r = run_reduced_coupled(out, "--set dem.interface.bond.precrack.box=[[-1,-1,-1],[0.030,1,1]]"
+                                          " --set dem.interface.bond.sigma_max=1.0e9 --set dem.interface.bond.G_I=1.0e6"
+                                          " --set time.end=1.1e-3");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto rows = test::read_csv(out / "series.csv");
   const auto secant = [&rows](double delta) {  // P / Delta, linear between rows
@@ -296,8 +300,7 @@ TEST(Dcb, CoupledDcbStopsWhenTheCrackRunsThroughTheOverlap) {
 #endif
   const auto out = test::scratch_dir("dcb_coupled_overlap_damage");
   // The first link there fails at t = 0.60 ms (weight 0.92).
-  const auto r = test::run_arlequin("run " + coupled_case + reduced_coupled +
-                                    " --set coupling.overlap.band.center=2.2e-3 --set time.end=8.0e-4 --out " + out.string());
+  const auto r = run_reduced_coupled(out, "--set coupling.overlap.band.center=2.2e-3 --set time.end=8.0e-4");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("damage reached the coupling overlap: bond"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("of 'interface'"), std::string::npos) << r.output;
