@@ -32,33 +32,34 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
   }
 }
 
-// Lanes [first, first + count) of a batch, vectorised across lanes: H, the Green-Lagrange strain
-// in Voigt order (xx, yy, zz, yz, xz, xy; engineering shears 2 E_ij = H_ij + H_ji + sum_k H_ki
-// H_kj), S = C E, w P = w F S, and each entry's w P grad N. M > 0: the batch's node count known
-// at compile time, so that the loops over entries unroll and the loop over lanes vectorises;
-// M = 0: any count.
-template <int M>
+// Lanes [first, first + count) of a batch, in three passes that each vectorise across lanes
+// for any node count: H = sum_k u_k (x) grad N_k, entry by entry; then per lane the
+// Green-Lagrange strain in Voigt order (xx, yy, zz, yz, xz, xy; engineering shears 2 E_ij = H_ij +
+// H_ji + sum_k H_ki H_kj), S = C E and w P = w F S; then each entry's w P grad N.
 void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const double* u, const double* w) {
-  const int lanes = static_cast<int>(b.point.size()), m = M > 0 ? M : b.nodes_per_point;
+  const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
   double c[6][6];
   for (int r = 0; r < 6; ++r)
     for (int s = 0; s < 6; ++s) c[r][s] = b.C(r, s);
-  const int* dof = b.dof.data();
-  const int* point = b.point.data();
-  const double *gx = b.gx.data(), *gy = b.gy.data(), *gz = b.gz.data();
-  double* force = b.force.data();
+  double h[9][kTile], p[9][kTile];
+  for (auto& row : h) std::fill(row, row + count, 0.0);
+  for (int k = 0; k < m; ++k) {
+    const size_t e0 = static_cast<size_t>(k) * lanes + first;
+    const int* dof = b.dof.data() + e0;
+    const double *gx = b.gx.data() + e0, *gy = b.gy.data() + e0, *gz = b.gz.data() + e0;
+#pragma omp simd
+    for (int t = 0; t < count; ++t) {
+      const double u0 = u[dof[t]], u1 = u[dof[t] + 1], u2 = u[dof[t] + 2];
+      h[0][t] += u0 * gx[t], h[1][t] += u0 * gy[t], h[2][t] += u0 * gz[t];
+      h[3][t] += u1 * gx[t], h[4][t] += u1 * gy[t], h[5][t] += u1 * gz[t];
+      h[6][t] += u2 * gx[t], h[7][t] += u2 * gy[t], h[8][t] += u2 * gz[t];
+    }
+  }
+  const int* point = b.point.data() + first;
 #pragma omp simd
   for (int t = 0; t < count; ++t) {
-    const int i = first + t;
-    double h00 = 0, h01 = 0, h02 = 0, h10 = 0, h11 = 0, h12 = 0, h20 = 0, h21 = 0, h22 = 0;
-#pragma GCC unroll 16
-    for (int k = 0; k < m; ++k) {
-      const int e = k * lanes + i, a = dof[e];
-      const double x = gx[e], y = gy[e], z = gz[e], u0 = u[a], u1 = u[a + 1], u2 = u[a + 2];
-      h00 += u0 * x, h01 += u0 * y, h02 += u0 * z;
-      h10 += u1 * x, h11 += u1 * y, h12 += u1 * z;
-      h20 += u2 * x, h21 += u2 * y, h22 += u2 * z;
-    }
+    const double h00 = h[0][t], h01 = h[1][t], h02 = h[2][t], h10 = h[3][t], h11 = h[4][t], h12 = h[5][t],
+                 h20 = h[6][t], h21 = h[7][t], h22 = h[8][t];
     const double strain[6] = {h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20),
                               h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21),
                               h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22),
@@ -70,23 +71,27 @@ void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const 
       s[r] = c[r][0] * strain[0] + c[r][1] * strain[1] + c[r][2] * strain[2] + c[r][3] * strain[3] +
              c[r][4] * strain[4] + c[r][5] * strain[5];
     // w P = w (I + H) S, S symmetric: rows (xx, xy, xz), (xy, yy, yz), (xz, yz, zz).
-    const double wq = w[point[i]];
-    const double p00 = wq * ((1 + h00) * s[0] + h01 * s[5] + h02 * s[4]);
-    const double p01 = wq * ((1 + h00) * s[5] + h01 * s[1] + h02 * s[3]);
-    const double p02 = wq * ((1 + h00) * s[4] + h01 * s[3] + h02 * s[2]);
-    const double p10 = wq * (h10 * s[0] + (1 + h11) * s[5] + h12 * s[4]);
-    const double p11 = wq * (h10 * s[5] + (1 + h11) * s[1] + h12 * s[3]);
-    const double p12 = wq * (h10 * s[4] + (1 + h11) * s[3] + h12 * s[2]);
-    const double p20 = wq * (h20 * s[0] + h21 * s[5] + (1 + h22) * s[4]);
-    const double p21 = wq * (h20 * s[5] + h21 * s[1] + (1 + h22) * s[3]);
-    const double p22 = wq * (h20 * s[4] + h21 * s[3] + (1 + h22) * s[2]);
-#pragma GCC unroll 16
-    for (int k = 0; k < m; ++k) {
-      const int e = k * lanes + i;
-      const double x = gx[e], y = gy[e], z = gz[e];
-      force[(3 * k) * kTile + t] = p00 * x + p01 * y + p02 * z;
-      force[(3 * k + 1) * kTile + t] = p10 * x + p11 * y + p12 * z;
-      force[(3 * k + 2) * kTile + t] = p20 * x + p21 * y + p22 * z;
+    const double wq = w[point[t]];
+    p[0][t] = wq * ((1 + h00) * s[0] + h01 * s[5] + h02 * s[4]);
+    p[1][t] = wq * ((1 + h00) * s[5] + h01 * s[1] + h02 * s[3]);
+    p[2][t] = wq * ((1 + h00) * s[4] + h01 * s[3] + h02 * s[2]);
+    p[3][t] = wq * (h10 * s[0] + (1 + h11) * s[5] + h12 * s[4]);
+    p[4][t] = wq * (h10 * s[5] + (1 + h11) * s[1] + h12 * s[3]);
+    p[5][t] = wq * (h10 * s[4] + (1 + h11) * s[3] + h12 * s[2]);
+    p[6][t] = wq * (h20 * s[0] + h21 * s[5] + (1 + h22) * s[4]);
+    p[7][t] = wq * (h20 * s[5] + h21 * s[1] + (1 + h22) * s[3]);
+    p[8][t] = wq * (h20 * s[4] + h21 * s[3] + (1 + h22) * s[2]);
+  }
+  double* force = b.force.data();
+  for (int k = 0; k < m; ++k) {
+    const size_t e0 = static_cast<size_t>(k) * lanes + first;
+    const double *gx = b.gx.data() + e0, *gy = b.gy.data() + e0, *gz = b.gz.data() + e0;
+    double *fx = force + (3 * k) * kTile, *fy = fx + kTile, *fz = fy + kTile;
+#pragma omp simd
+    for (int t = 0; t < count; ++t) {
+      fx[t] = p[0][t] * gx[t] + p[1][t] * gy[t] + p[2][t] * gz[t];
+      fy[t] = p[3][t] * gx[t] + p[4][t] * gy[t] + p[5][t] * gz[t];
+      fz[t] = p[6][t] * gx[t] + p[7][t] * gy[t] + p[8][t] * gz[t];
     }
   }
 }
@@ -98,11 +103,7 @@ void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<
     const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
     for (int first = 0; first < lanes; first += kTile) {
       const int count = std::min(kTile, lanes - first);
-      switch (m) {  // P1 tetrahedra have 4 nodes per point, P2 10
-        case 4: tile_forces<4>(b, first, count, u.data(), w.data()); break;
-        case 10: tile_forces<10>(b, first, count, u.data(), w.data()); break;
-        default: tile_forces<0>(b, first, count, u.data(), w.data());
-      }
+      tile_forces(b, first, count, u.data(), w.data());
       for (int t = 0; t < count; ++t)
         for (int k = 0; k < m; ++k) {
           double* f = &f_int[static_cast<size_t>(b.dof[static_cast<size_t>(k) * lanes + first + t])];

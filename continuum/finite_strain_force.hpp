@@ -40,7 +40,6 @@ class FiniteStrainForce {
   // Lanes are computed a tile at a time, so a tile's node forces are still in cache when they
   // are added to f_int.
   static constexpr int kTile = 256;
-  template <int M>
   static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w);
   std::vector<Batch> batches_;
 };

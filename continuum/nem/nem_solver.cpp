@@ -36,30 +36,46 @@ struct Plane {
 
 }  // namespace
 
+// One body of the mesh: a connected set of tetrahedra, convex, sharing no node with another.
+struct Body {
+  std::vector<int> nodes;  // mesh node ids
+  Dt3 dt;                  // its nodes (vertex info: mesh node id)
+  std::vector<Plane> planes;
+  Polyhedron domain;  // its bounding box clipped by its planes (face tag -1 - k: plane k)
+};
+
 struct NemSolver::Geometry {
   Coordinates kind = Coordinates::sibson;
   double tol = 0;  // length: "on a plane" for nodes and points
-  Dt3 dt;
-  std::vector<Plane> planes;
+  std::vector<Body> bodies;
   const std::vector<Vec3>* x = nullptr;
 
-  // Natural-neighbour coordinates on domain plane k (p projected onto it).
-  bool on_plane(int k, const Vec3& p, Coords& out) const {
-    return nem::natural_neighbour_coordinates(planes[k].dt, planes[k].local(p), kind, out);
+  // Natural-neighbour coordinates on domain plane k of body b (p projected onto it).
+  bool on_plane(const Body& b, int k, const Vec3& p, Coords& out) const {
+    return nem::natural_neighbour_coordinates(b.planes[k].dt, b.planes[k].local(p), kind, out);
   }
 
-  // Shape functions at any point of the closed domain; false outside it.
+  // Shape functions at any point of the closed domain: those of the first body holding it (the
+  // bodies share no node, so a point on a face two bodies share takes one body's); false
+  // outside every body.
   bool coords(const Vec3& p, Coords& out) const {
+    for (const Body& b : bodies)
+      if (coords(b, p, out)) return true;
+    return false;
+  }
+
+  // Shape functions at a point of body b; false outside it.
+  bool coords(const Body& b, const Vec3& p, Coords& out) const {
     out.clear();
     std::vector<int> on;
-    for (int k = 0; k < static_cast<int>(planes.size()); ++k) {
-      const double s = dot(planes[k].n, p) - planes[k].d;
+    for (int k = 0; k < static_cast<int>(b.planes.size()); ++k) {
+      const double s = dot(b.planes[k].n, p) - b.planes[k].d;
       if (s > tol) return false;
       if (s >= -tol) on.push_back(k);
     }
-    if (on.size() == 1) return on_plane(on[0], p, out);
-    if (on.size() >= 2) return on_edge_or_corner(on, p, out);
-    if (kind == Coordinates::sibson && nem::natural_neighbour_coordinates(dt, p, Coordinates::sibson, out)) {
+    if (on.size() == 1) return on_plane(b, on[0], p, out);
+    if (on.size() >= 2) return on_edge_or_corner(b, on, p, out);
+    if (kind == Coordinates::sibson && nem::natural_neighbour_coordinates(b.dt, p, Coordinates::sibson, out)) {
       // Sibson volumes use the circumcentre of every conflict cell; a flat cell (four
       // cocircular nodes on a flat boundary face, common in gmsh surface meshes) spoils them.
       // Such points are caught by the linear-reproduction check and get Laplace coordinates.
@@ -67,14 +83,14 @@ struct NemSolver::Geometry {
       for (const auto& [J, value] : out) r += value * (*x)[J];
       if (norm(r - p) <= 1e-3 * tol) return true;
     }
-    return nem::natural_neighbour_coordinates(dt, p, Coordinates::laplace, out);
+    return nem::natural_neighbour_coordinates(b.dt, p, Coordinates::laplace, out);
   }
 
-  // On an edge of the domain (two or more planes): the 1D linear interpolant between the
-  // nearest nodes of the edge on either side; at a corner, the corner node.
-  bool on_edge_or_corner(const std::vector<int>& on, const Vec3& p, Coords& out) const {
-    const Vec3 t = cross(planes[on[0]].n, planes[on[1]].n);
-    const auto nearest = dt.nearest_vertex(P3(p));
+  // On an edge of body b (two or more planes): the 1D linear interpolant between the nearest
+  // nodes of the edge on either side; at a corner, the corner node.
+  bool on_edge_or_corner(const Body& b, const std::vector<int>& on, const Vec3& p, Coords& out) const {
+    const Vec3 t = cross(b.planes[on[0]].n, b.planes[on[1]].n);
+    const auto nearest = b.dt.nearest_vertex(P3(p));
     if (on.size() >= 3 || norm(t) < 1e-12) {
       if (norm((*x)[nearest->info()] - p) > tol) return false;
       out.push_back({nearest->info(), 1.0});
@@ -83,9 +99,10 @@ struct NemSolver::Geometry {
     const Vec3 dir = normalized(t);
     int lo = -1, hi = -1;
     double slo = -1e300, shi = 1e300;
-    for (int i = 0; i < static_cast<int>(x->size()); ++i) {
+    for (int i : b.nodes) {
       const Vec3& xi = (*x)[i];
-      if (std::abs(dot(planes[on[0]].n, xi) - planes[on[0]].d) > tol || std::abs(dot(planes[on[1]].n, xi) - planes[on[1]].d) > tol)
+      if (std::abs(dot(b.planes[on[0]].n, xi) - b.planes[on[0]].d) > tol ||
+          std::abs(dot(b.planes[on[1]].n, xi) - b.planes[on[1]].d) > tol)
         continue;
       const double s = dot(xi - p, dir);
       if (s <= 0 && s > slo) slo = s, lo = i;
@@ -101,6 +118,31 @@ struct NemSolver::Geometry {
     return true;
   }
 };
+
+namespace {
+
+// The bodies of the mesh: its tetrahedra joined through shared nodes (union-find); each body's
+// nodes in increasing order, bodies by their first node.
+std::vector<std::vector<int>> mesh_bodies(const Mesh& mesh) {
+  std::vector<int> parent(mesh.num_nodes());
+  for (int i = 0; i < mesh.num_nodes(); ++i) parent[i] = i;
+  const auto root = [&parent](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (int e = 0; e < mesh.num_tets(); ++e)
+    for (int a = 1; a < mesh.nodes_per_tet(); ++a) {
+      const int r0 = root(mesh.tet(e)[0]), r1 = root(mesh.tet(e)[a]);
+      if (r0 != r1) parent[std::max(r0, r1)] = std::min(r0, r1);
+    }
+  std::map<int, std::vector<int>> by_root;
+  for (int i = 0; i < mesh.num_nodes(); ++i) by_root[root(i)].push_back(i);
+  std::vector<std::vector<int>> bodies;
+  for (auto& [r, nodes] : by_root) bodies.push_back(std::move(nodes));
+  return bodies;
+}
+
+}  // namespace
 
 std::unique_ptr<ContinuumSolver> NemSolver::create(const ContinuumSettings& settings) {
   return std::make_unique<NemSolver>(settings);
@@ -126,48 +168,60 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   const double L = norm(hi - lo);
   g.tol = 1e-9 * L;
 
-  // Domain planes: the distinct planes of the boundary triangles.
+  // Bodies, and per body its domain planes (the distinct planes of its boundary triangles), its
+  // tessellations and its domain as a polyhedron.
+  const std::vector<std::vector<int>> body_nodes = mesh_bodies(mesh_);
+  std::vector<int> body_of(n);
+  g.bodies.resize(body_nodes.size());
+  for (size_t k = 0; k < body_nodes.size(); ++k) {
+    g.bodies[k].nodes = body_nodes[k];
+    for (int i : body_nodes[k]) body_of[i] = static_cast<int>(k);
+  }
+  const std::string several = g.bodies.size() > 1 ? " of body " : "";
   for (const auto& tri : mesh_.boundary_triangles()) {
+    Body& body = g.bodies[body_of[tri[0]]];
     const Vec3 nn = normalized(cross(X[tri[1]] - X[tri[0]], X[tri[2]] - X[tri[0]]));
     const double d = dot(nn, X[tri[0]]);
-    const bool known = std::any_of(g.planes.begin(), g.planes.end(),
+    const bool known = std::any_of(body.planes.begin(), body.planes.end(),
                                    [&](const Plane& p) { return norm(p.n - nn) < 1e-9 && std::abs(p.d - d) < g.tol; });
     if (!known) {
       Plane p;
       p.n = nn;
       p.d = d;
-      g.planes.push_back(std::move(p));
+      body.planes.push_back(std::move(p));
     }
   }
-  for (Plane& p : g.planes) {
-    p.e1 = normalized(std::abs(p.n.x) < 0.9 ? cross(p.n, Vec3{1, 0, 0}) : cross(p.n, Vec3{0, 1, 0}));
-    p.e2 = cross(p.n, p.e1);
-    p.origin = p.d * p.n;
-    std::vector<std::pair<Kernel::Point_2, int>> pts;
-    for (int i = 0; i < n; ++i) {
-      const double s = dot(p.n, X[i]) - p.d;
-      if (s > g.tol)
-        throw InputError("nem: the domain is not convex (node " + std::to_string(i) +
-                         " lies outside the plane of a boundary face); only convex domains are supported");
-      if (s >= -g.tol) pts.push_back({p.local(X[i]), i});
+  for (size_t k = 0; k < g.bodies.size(); ++k) {
+    Body& body = g.bodies[k];
+    const std::string which = several.empty() ? "" : several + std::to_string(k) + " (node " + std::to_string(body.nodes[0]) + ")";
+    for (Plane& p : body.planes) {
+      p.e1 = normalized(std::abs(p.n.x) < 0.9 ? cross(p.n, Vec3{1, 0, 0}) : cross(p.n, Vec3{0, 1, 0}));
+      p.e2 = cross(p.n, p.e1);
+      p.origin = p.d * p.n;
+      std::vector<std::pair<Kernel::Point_2, int>> pts;
+      for (int i : body.nodes) {
+        const double s = dot(p.n, X[i]) - p.d;
+        if (s > g.tol)
+          throw InputError("nem: the domain" + which + " is not convex (node " + std::to_string(i) +
+                           " lies outside the plane of a boundary face); only convex bodies are supported");
+        if (s >= -g.tol) pts.push_back({p.local(X[i]), i});
+      }
+      p.dt.insert(pts.begin(), pts.end());
     }
-    p.dt.insert(pts.begin(), pts.end());
-  }
-  {
     std::vector<std::pair<Kernel::Point_3, int>> pts;
-    for (int i = 0; i < n; ++i) pts.push_back({P3(X[i]), i});
-    g.dt.insert(pts.begin(), pts.end());
-    if (static_cast<int>(g.dt.number_of_vertices()) != n) throw InputError("nem: duplicate nodes in the mesh");
-  }
-
-  // The domain as a polyhedron: its bounding box clipped by every domain plane.
-  Polyhedron domain;
-  {
-    const Vec3 a = lo - 0.01 * L * Vec3{1, 1, 1}, b = hi + 0.01 * L * Vec3{1, 1, 1};
-    domain = box_polyhedron(a, b, -1000000);
-    for (int k = 0; k < static_cast<int>(g.planes.size()); ++k) clip(domain, g.planes[k].n, g.planes[k].d, -1 - k, 1e-12 * L);
-    for (const PolyFace& f : domain)
-      if (f.tag == -1000000) throw InputError("nem: the mesh boundary does not close a convex domain");
+    Vec3 blo = X[body.nodes[0]], bhi = blo;
+    for (int i : body.nodes) {
+      pts.push_back({P3(X[i]), i});
+      for (int c = 0; c < 3; ++c) blo[c] = std::min(blo[c], X[i][c]), bhi[c] = std::max(bhi[c], X[i][c]);
+    }
+    body.dt.insert(pts.begin(), pts.end());
+    if (body.dt.number_of_vertices() != body.nodes.size()) throw InputError("nem: duplicate nodes in the mesh" + which);
+    const Vec3 a = blo - 0.01 * L * Vec3{1, 1, 1}, b = bhi + 0.01 * L * Vec3{1, 1, 1};
+    body.domain = box_polyhedron(a, b, -1000000);
+    for (int m = 0; m < static_cast<int>(body.planes.size()); ++m)
+      clip(body.domain, body.planes[m].n, body.planes[m].d, -1 - m, 1e-12 * L);
+    for (const PolyFace& f : body.domain)
+      if (f.tag == -1000000) throw InputError("nem: the mesh boundary does not close a convex domain" + which);
   }
 
   // Node materials: that of the first tetrahedron holding the node.
@@ -183,17 +237,18 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   // One integration point per sub-cell, b_J = (int phi_J n dS over its surface) / volume.
   using Flux = std::vector<std::pair<int, Vec3>>;  // (J, int phi_J n dS)
   std::vector<Dt3::Vertex_handle> vh(n);
-  for (auto v = g.dt.finite_vertices_begin(); v != g.dt.finite_vertices_end(); ++v) vh[v->info()] = v;
+  for (const Body& body : g.bodies)
+    for (auto v = body.dt.finite_vertices_begin(); v != body.dt.finite_vertices_end(); ++v) vh[v->info()] = v;
   Coords phi;
   // Midpoint rule on triangle (a, b, c) with area vector an (area times unit normal); plane >= 0:
   // the triangle lies on that domain plane, its point then also joins the boundary rule for
   // tractions (so loads and gradients satisfy the same integration constraint).
   std::vector<Eigen::Triplet<double>> boundary_phi;
-  auto add_flux = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& an, int plane, Flux& out) {
+  auto add_flux = [&](const Body& body, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& an, int plane, Flux& out) {
     const double area = norm(an);
     if (!(area > 0)) return;
     const Vec3 q = (a + b + c) / 3.0;
-    if (!(plane >= 0 ? g.on_plane(plane, q, phi) : g.coords(q, phi)))
+    if (!(plane >= 0 ? g.on_plane(body, plane, q, phi) : g.coords(body, q, phi)))
       throw RunError("nem: natural-neighbour coordinates failed at a Voronoi cell point");
     for (const auto& [J, value] : phi) out.push_back({J, value * an});
     if (plane >= 0) {
@@ -219,9 +274,10 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
   };
   cell_volume_.assign(n, 0.0);
   for (int i = 0; i < n; ++i) {
-    Polyhedron cell = domain;
+    const Body& body = g.bodies[body_of[i]];
+    Polyhedron cell = body.domain;
     std::vector<Dt3::Vertex_handle> adj;
-    g.dt.finite_adjacent_vertices(vh[i], std::back_inserter(adj));
+    body.dt.finite_adjacent_vertices(vh[i], std::back_inserter(adj));
     for (const auto& v : adj) {
       const int j = v->info();
       const Vec3 nn = normalized(X[j] - X[i]);
@@ -261,8 +317,8 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
         for (size_t m = 0; m < k; ++m) {
           const auto [before, after] = midpoints(m);
           const Vec3& p = f.pts[m];
-          add_flux(c, before, p, 0.5 * norm(cross(before - c, p - c)) * f.n, plane, parts.flux[m]);
-          add_flux(c, p, after, 0.5 * norm(cross(p - c, after - c)) * f.n, plane, parts.flux[m]);
+          add_flux(body, c, before, p, 0.5 * norm(cross(before - c, p - c)) * f.n, plane, parts.flux[m]);
+          add_flux(body, c, p, after, 0.5 * norm(cross(p - c, after - c)) * f.n, plane, parts.flux[m]);
         }
         if (f.tag > i) shared[{i, f.tag}] = parts;
       }
@@ -291,7 +347,7 @@ NemSolver::NemSolver(const ContinuumSettings& settings) : ContinuumSolver(settin
         // is outward: signed, so it holds when x_i lies on the face (flat tetrahedra) too.
         const Vec3 an = 0.5 * sense * cross(c - X[i], after - X[i]);
         Flux flux;
-        add_flux(X[i], c, after, an, -1, flux);
+        add_flux(body, X[i], c, after, an, -1, flux);
         s_m.flux.insert(s_m.flux.end(), flux.begin(), flux.end());
         for (auto& [J, value] : flux) sub[next].flux.push_back({J, -value});
       }

@@ -49,8 +49,13 @@
 //   the mesh boundary triangle that holds it), so loads and smoothed gradients satisfy the same
 //   integration constraint and the traction (Neumann) patch test is passed exactly.
 // - Lumped mass m_i = alpha(x_i) rho |V_i|.
-// Supported domains: convex polyhedra (the mesh boundary must be the convex hull of the nodes;
-// otherwise InputError). See continuum/README.md for what a constrained version needs.
+// Supported domains: one or more convex bodies. A body is a connected set of tetrahedra (joined
+// through shared nodes); bodies share no node (e.g. the two arms of the coupled DCB, meshed
+// apart). Each body is tessellated alone and must be a convex polyhedron (its boundary the convex
+// hull of its nodes; otherwise InputError); its nodes' cells, shape functions and gradients see
+// only its own nodes, and a point takes the shape functions of the first body that holds it (on
+// a face two bodies share, the first body's). See continuum/README.md for what a constrained
+// (non-convex) version needs.
 #pragma once
 #include <memory>
 

@@ -101,6 +101,39 @@ TEST(ContinuumNem, ConsistencyOfShapeFunctionsAndCells) {
   }
 }
 
+// Two bodies that share no node (meshes/two_blocks.geo, stacked in z, a node of each on every
+// point of z = 1): each is tessellated alone, a point takes the shape functions of the body that
+// holds it (partition of unity, linear reproduction, nodes of that body only), the cells fill both
+// (volume 2), and the Dirichlet patch test holds on the pair.
+TEST(ContinuumNem, TwoBodiesAreTessellatedApart) {
+  const Material mat = Material::isotropic(1e3, 0.3, 1.0);
+  auto s = std::make_unique<NemSolver>(settings("two_blocks.geo", 0.3, 1, mat));
+  std::vector<Vec3> pts;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(0, 1);
+  for (int i = 0; i < 200; ++i) pts.push_back({uni(rng), uni(rng), 2.0 * uni(rng)});
+  const InterpolationOperator N = s->interpolation(pts);
+  for (size_t p = 0; p < pts.size(); ++p) {
+    const bool lower = pts[p].z < 1.0;
+    double sum = 0;
+    Vec3 x{};
+    for (InterpolationOperator::InnerIterator it(N, p); it; ++it) {
+      sum += it.value();
+      x += it.value() * s->nodes()[it.col()];
+      const double z = s->nodes()[it.col()].z;
+      EXPECT_TRUE(lower ? z <= 1.0 : z >= 1.0) << "point " << p << " (z = " << pts[p].z << ") takes node " << it.col();
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12) << "point " << p;
+    EXPECT_LT(norm(x - pts[p]), 1e-12) << "point " << p;
+  }
+  double v = 0;
+  for (double vi : s->cell_volumes()) v += vi;
+  EXPECT_NEAR(v, 2.0, 1e-12);
+  const PatchErrors e = patch_test(*s, mat, false);
+  EXPECT_LT(e.displacement, 1e-10);
+  EXPECT_LT(e.stress, 1e-10);
+}
+
 // Dirichlet and traction (Neumann) patch tests; the latter needs tractions integrated with the
 // boundary rule of the smoothed gradients (integration constraint).
 TEST(ContinuumNem, PatchTest) {
