@@ -10,9 +10,10 @@
 //    weights w (w_q = alpha(x_q) |cell_q|, read at every call, so weights may change between
 //    calls). Nothing is allocated per call.
 //  - Layout (why a class): the points are grouped into batches of equal node count and material
-//    and stored lane-major (entry k of lane i at k * lanes + i), so that one vectorised pass
-//    computes H, E, S and P of many points at once; their node forces are then added to f_int
-//    in a fixed order. One thread, as the rest of the continuum's step.
+//    and stored lane-major (entry k of lane i at k * lanes + i), so that passes over a tile of
+//    lanes compute H, E, S and P of many points at once, vectorised for any node count; their
+//    node forces are then added to f_int in a fixed order. One thread, as the rest of the
+//    continuum's step.
 #pragma once
 #include <vector>
 
