@@ -75,8 +75,6 @@ Kinematics kinematics_from_name(const std::string& name) {
   throw InputError("unknown kinematics '" + name + "' (known: small, finite)");
 }
 
-const char* kinematics_name(Kinematics k) { return k == Kinematics::small ? "small" : "finite"; }
-
 ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings)
     : mesh_(Mesh::load(settings.mesh)), kinematics_(settings.kinematics) {
   PetscSession::ensure(settings.petsc_options);
@@ -356,7 +354,6 @@ void ContinuumSolver::internal_force(const Field& u, Field& f_int) const {
   }
   finite_force_.compute(u, point_weight_, f_int);
 }
-
 
 void ContinuumSolver::add_external_force(Field& f) const {
   for (const Traction& tr : tractions_) {

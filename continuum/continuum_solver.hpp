@@ -61,7 +61,6 @@ struct RegionMaterial {
 // The strain measure (contract above).
 enum class Kinematics { small, finite };
 Kinematics kinematics_from_name(const std::string& name);  // "small" or "finite"; InputError otherwise
-const char* kinematics_name(Kinematics k);
 
 struct ContinuumSettings {
   MeshSource mesh;
@@ -163,7 +162,6 @@ class ContinuumSolver {
   // unread (checked on a 1 x 1 system, so a case is refused before its run; starts PETSc).
   static void check_static_solver_options(const std::string& petsc_options);
 
-  Kinematics kinematics() const { return kinematics_; }
   // f_int(u) of the solver's kinematics; K u for small ones.
   void internal_force(const Field& u, Field& f_int) const;
   // Small kinematics: 1/2 u.K u, one pass over K. A rigid part of u cancels to round-off
