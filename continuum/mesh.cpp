@@ -208,7 +208,12 @@ Mesh Mesh::load(const MeshSource& source) {
   tets.reserve(tet_node_tags.size());
   for (std::size_t t : tet_node_tags) {
     auto [it, fresh] = node_index.try_emplace(t, static_cast<int>(nodes.size()));
-    if (fresh) nodes.push_back(tag_xyz.at(t));
+    if (fresh) {
+      const auto xyz = tag_xyz.find(t);
+      if (xyz == tag_xyz.end())
+        throw InputError(source.path + ": a tetrahedron names node " + std::to_string(t) + ", which the file does not define");
+      nodes.push_back(xyz->second);
+    }
     tets.push_back(it->second);
   }
   std::unordered_map<std::size_t, int> tet_index;
@@ -240,12 +245,28 @@ Mesh Mesh::load(const MeshSource& source) {
       gmsh::model::mesh::getElements(etypes, etags, enodes, dim, ent);
       for (size_t k = 0; k < etypes.size(); ++k) {
         if (dim == 3) {
-          for (std::size_t t : etags[k]) g.tets.push_back(tet_index.at(t));
+          for (std::size_t t : etags[k]) {
+            const auto tet = tet_index.find(t);
+            if (tet == tet_index.end())
+              throw InputError(source.path + ": physical group '" + g.name + "' holds element " + std::to_string(t) +
+                               ", which is not one of the mesh's tetrahedra");
+            g.tets.push_back(tet->second);
+          }
         } else {
-          const size_t per = enodes[k].size() / std::max<size_t>(etags[k].size(), 1);
+          if (etypes[k] != 2 && etypes[k] != 9)
+            throw InputError(source.path + ": physical group '" + g.name + "' holds surface elements of gmsh type " +
+                             std::to_string(etypes[k]) + " (expected triangles, types 2 and 9)");
+          const size_t per = etypes[k] == 2 ? 3 : 6;
+          auto volume_node = [&](std::size_t t) {
+            const auto node = node_index.find(t);
+            if (node == node_index.end())
+              throw InputError(source.path + ": physical group '" + g.name + "' has a triangle on node " +
+                               std::to_string(t) + ", which no tetrahedron uses");
+            return node->second;
+          };
           for (size_t f = 0; f < etags[k].size(); ++f)
-            g.triangles.push_back({node_index.at(enodes[k][per * f]), node_index.at(enodes[k][per * f + 1]),
-                                   node_index.at(enodes[k][per * f + 2])});
+            g.triangles.push_back({volume_node(enodes[k][per * f]), volume_node(enodes[k][per * f + 1]),
+                                   volume_node(enodes[k][per * f + 2])});
         }
       }
     }

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
 
 #include "common/error.hpp"
 #include "continuum/mesh.hpp"
@@ -92,6 +94,28 @@ TEST(ContinuumMesh, ProblemsAreClearErrors) {
   // Empty region.
   PhysicalGroup empty{"hole", 3, {}, {}, {}};
   EXPECT_THROW(Mesh(1, x, {0, 1, 2, 3}, {empty}), InputError);
+}
+
+// A surface group whose triangle stands on a node no tetrahedron uses (found by fuzz_mesh): an
+// InputError naming the group and the node, not an out-of-range exception.
+TEST(ContinuumMesh, SurfaceOnANodeNoTetrahedronUsesIsAClearError) {
+  const std::string path = ::testing::TempDir() + "loose_triangle.msh";
+  {
+    std::ofstream f(path);
+    f << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+         "$PhysicalNames\n2\n2 1 \"loose\"\n3 2 \"body\"\n$EndPhysicalNames\n"
+         "$Nodes\n5\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 1 1 1\n$EndNodes\n"
+         "$Elements\n2\n1 2 2 1 1 1 2 5\n2 4 2 2 2 1 2 3 4\n$EndElements\n";
+  }
+  try {
+    Mesh::load({path, 0.0, 1, {}});
+    FAIL() << "a triangle on an unused node was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'loose'"), std::string::npos) << what;
+    EXPECT_NE(what.find("node 5"), std::string::npos) << what;
+  }
+  std::remove(path.c_str());
 }
 
 TEST(ContinuumRegistry, NamesAndUnknown) {
