@@ -62,6 +62,7 @@ constexpr const char* usage_run =
     "  --steps N      stop after N steps (before time.end the case's checks are not evaluated)\n"
     "  --petsc \"...\"  PETSc options of a static continuum solve (checked before the run), e.g. --petsc \"-ksp_type cg -pc_type jacobi\"\n"
     "  --quiet        no progress line\n"
+    "  --profile      print the wall time of each phase of the step (docs/performance.md)\n"
     "exit codes: 0 done and the case's checks passed, 2 bad input, 3 run stopped, 5 a check failed,\n"
     "  130 / 143 interrupted by Ctrl-C / SIGTERM (outputs so far closed and kept)\n";
 
@@ -84,13 +85,14 @@ constexpr const char* usage_compare =
     "  compare_<sensor>.png. Each run is judged by its own case's checks: exit 5 if one fails\n";
 
 constexpr const char* usage_virtual_test =
-    "usage: arlequin virtual-test SPEC.yaml [--out DIR] [--sample NAME ...] [--set k=v ...]\n"
+    "usage: arlequin virtual-test SPEC.yaml [--out DIR] [--sample NAME ...] [--test NAME ...] [--set k=v ...] [--profile]\n"
     "  runs the spec's quasi-static tests (tension, shear) on each of its samples (only the named\n"
-    "  ones with --sample), results in DIR/<sample>/<test>/ (default results/<folder>_<spec>/);\n"
+    "  ones with --sample, only the named tests with --test), results in DIR/<sample>/<test>/ (default results/<folder>_<spec>/);\n"
     "  prints moduli and Poisson ratios with their uncertainty, writes DIR/tests.csv and, for a\n"
     "  composite spec, DIR/composite.md (engineering constants against closed forms and references);\n"
     "  with a failure section every test runs to failure: DIR/failure.csv and DIR/failure.md.\n"
-    "  --set applies to the sample case. Spec format: app/virtual_tests.hpp\n";
+    "  --set applies to the sample case. --profile: the wall time of each phase of the step, summed\n"
+    "  over the runs (docs/performance.md). Spec format: app/virtual_tests.hpp\n";
 
 constexpr const char* usage_calibrate =
     "usage: arlequin calibrate SPEC.yaml [--out DIR] [--set k=v ...]\n"
@@ -118,6 +120,8 @@ struct Arguments {
   std::filesystem::path restart;  // run --restart
   std::vector<app::SweepAxis> axes;
   std::vector<std::string> samples;  // virtual-test --sample
+  std::vector<std::string> tests;    // virtual-test --test
+  bool profile = false;              // run, virtual-test --profile
   std::string document = "case";     // schema --of
   bool quiet = false;
   bool help = false;
@@ -168,6 +172,10 @@ Arguments parse(int argc, char** argv) {
         throw InputError("arlequin schema --of " + a.document + ": expected case, virtual-test or calibrate");
     } else if (arg == "--sample" && a.command == "virtual-test") {
       a.samples.push_back(value("a sample name"));
+    } else if (arg == "--test" && a.command == "virtual-test") {
+      a.tests.push_back(value("a test name"));
+    } else if (arg == "--profile" && (a.command == "run" || a.command == "virtual-test")) {
+      a.profile = true;
     } else if (arg == "--quiet" && a.command == "run") {
       a.quiet = true;
     } else if (!arg.starts_with("-") && a.case_file.empty()) {
@@ -255,7 +263,10 @@ int run(const Arguments& a) {
   const auto t0 = std::chrono::steady_clock::now();
   // A checkpoint that cannot be read is refused before the scene is built.
   const std::optional<StateArchive> restart = a.restart.empty() ? std::nullopt : std::optional(read_state_file(a.restart));
-  app::Scene scene = app::build_scene(a.case_file, a.scene);
+  StepProfile profile;
+  app::SceneOptions scene_options = a.scene;
+  if (a.profile) scene_options.profile = &profile;
+  app::Scene scene = app::build_scene(a.case_file, scene_options);
   app::RunOptions options;
   if (restart) {
     options.restart = &*restart;
@@ -275,6 +286,7 @@ int run(const Arguments& a) {
   std::printf("energies [J]: kinetic %.6e  bond %.6e  contact %.6e  external work %.6e  dissipated %.6e  fracture %.6e\n",
               e.kinetic, e.bond, e.contact, e.external_work, e.dissipated, e.fracture);
   for (const auto& [name, value] : r.sensors) std::printf("sensor %s = %.9e\n", name.c_str(), value);
+  if (a.profile) std::printf("profile of the step, %d thread(s):\n%s", max_threads(), profile.table().c_str());
   for (const auto& c : r.checks) {
     if (c.check->bounded)
       std::printf("check %s %s: %.6e within [%.6g, %.6g]: %s\n", c.check->column.c_str(), app::describe(*c.check).c_str(),
@@ -334,8 +346,11 @@ std::filesystem::path spec_out_dir(const Arguments& a) {
 int virtual_test(const Arguments& a) {
   app::SceneOptions base = a.scene;
   base.out_dir.clear();
+  StepProfile profile;
+  if (a.profile) base.profile = &profile;
   const std::filesystem::path out = spec_out_dir(a);
-  const int stopped = app::run_virtual_test_suite(a.case_file, base, out, a.samples);
+  const int stopped = app::run_virtual_test_suite(a.case_file, base, out, a.samples, a.tests);
+  if (a.profile) std::printf("profile of the step, summed over the runs, %d thread(s):\n%s", max_threads(), profile.table().c_str());
   std::printf("results: %s\n", std::filesystem::absolute(out).string().c_str());
   return stopped == 0 ? 0 : 3;
 }

@@ -576,6 +576,26 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     output_seconds += seconds_since(t0);
   };
 
+  // --profile: the DEM times its phases, the runner its own, and the rest of a model step (the
+  // continuum and the coupling) is one phase.
+  StepProfile* const profile = scene.profile;
+  struct {
+    int checks = 0, outputs = 0, rest = 0;
+  } phase;
+  if (profile) {
+    model.set_profile(profile);
+    if (scene.continuum) phase.rest = profile->phase("continuum and coupling");
+    phase.checks = profile->phase("energy and overlap checks");
+    phase.outputs = profile->phase("sensors, energies, output");
+  }
+  const auto step_model = [&] {
+    if (!profile || !scene.continuum) return scene.model->step(scene.dt);
+    const double timed_before = profile->seconds();
+    const auto t0 = Clock::now();
+    scene.model->step(scene.dt);
+    profile->add(phase.rest, std::max(0.0, seconds_since(t0) - (profile->seconds() - timed_before)), true);
+  };
+
   const auto t_start = Clock::now();
   std::string failure;
   std::exception_ptr interrupted;  // Ctrl-C or SIGTERM: rethrown once the outputs are closed
@@ -593,10 +613,12 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     for (long n = first_step + 1; n <= total_steps; ++n) {
       if (const int signal = take_interrupt()) throw interruption(signal);
       if (output_after(n)) model.record_energies_in_next_step();  // the step's force pass gives the row's bond energies
-      scene.model->step(scene.dt);
+      step_model();
       ++steps_done;
+      if (profile) profile->count_step();
+      model.check_finite();  // the DEM times it
+      std::optional<PhaseTimer> timer(std::in_place, profile, phase.checks, false);
       if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
-      model.check_finite();
       if (const auto damage = scene.model->damage_in_overlap()) {
         const bool first = result.damage_in_overlap.empty();
         if (first) result.damage_in_overlap = "step " + std::to_string(n) + ": " + damage->description;
@@ -610,12 +632,14 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
         model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
                                     std::abs(model.external_work() + continuum_work(scene))) +
                            1e-300);
+      timer.emplace(profile, phase.outputs, false);
       if (output_after(n)) write_outputs();
       if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {
         save_checkpoint();
         while (next_checkpoint <= current_time() + slack) next_checkpoint += checkpoint_every;
       }
       progress.update(n, current_time());
+      timer.reset();
       if (!result.stop_reason.empty()) break;
     }
   } catch (const RunError& e) {
@@ -624,6 +648,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     failure = e.what();
     interrupted = std::current_exception();
   }
+  if (profile) model.set_profile(nullptr);
   // The state at the end, or where a signal stopped the run: between two steps, so whole.
   if (!static_only && (interrupted || (failure.empty() && checkpoint_every > 0.0))) save_checkpoint();
   progress.finish();

@@ -80,6 +80,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   CaseNode root = file.root();
   Scene scene;
   scene.case_file = case_file;
+  scene.profile = options.profile;
   scene.name = root.string_or("name", case_file.parent_path().filename().string());
   // The name is the default output folder's last component (results/<name>) and the packing
   // cache's: one plain component of portable characters, so that it cannot reach outside

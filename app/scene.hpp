@@ -17,6 +17,7 @@
 #include "app/scene_model.hpp"
 #include "common/case_file.hpp"
 #include "common/schema.hpp"
+#include "common/step_profile.hpp"
 #include "dem/dem_model.hpp"
 #include "dem/sample_file.hpp"
 
@@ -109,6 +110,7 @@ struct Scene {
   std::vector<Sensor> sensors;
   std::vector<Check> checks;
   OutputPlan output;
+  StepProfile* profile = nullptr;  // SceneOptions::profile
 
   // A static continuum and no DE: one solve, no time stepping (time is optional).
   bool static_only() const { return continuum && continuum->is_static() && dem.particles.size() == 0; }
@@ -121,6 +123,7 @@ struct SceneOptions {
   bool rebuild_sample = false;         // build the packing even if its cache file matches
   bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
   bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
+  StepProfile* profile = nullptr;      // --profile: runs time their step's phases into it
 };
 
 // The options of `arlequin check` (and of the fuzz targets, which read as it does): those given,

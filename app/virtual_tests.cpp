@@ -1061,7 +1061,8 @@ SuiteSpec read_suite(const std::filesystem::path& spec_file) {
 void validate_virtual_test_spec(const std::filesystem::path& spec_file) { read_suite(spec_file); }
 
 int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
-                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples) {
+                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples,
+                           const std::vector<std::string>& only_tests) {
   SuiteSpec spec = read_suite(spec_file);
   const std::filesystem::path& case_file = spec.case_file;
   const std::vector<SampleVariant>& samples = spec.samples;
@@ -1083,6 +1084,17 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
       throw InputError(spec_file.string() + ": --sample " + name + ": no sample of that name" +
                        (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; samples: " + listed));
     }
+  if (!only_tests.empty()) {
+    std::vector<std::string_view> test_names;
+    for (const LoadCase& t : tests) test_names.push_back(t.name);
+    for (const auto& name : only_tests)
+      if (std::find(test_names.begin(), test_names.end(), name) == test_names.end()) {
+        const auto guess = closest_match(name, test_names);
+        throw InputError(spec_file.string() + ": --test " + name + ": no test of that name" +
+                         (guess ? "; did you mean '" + std::string(*guess) + "'?" : ""));
+      }
+    std::erase_if(tests, [&](const LoadCase& t) { return std::find(only_tests.begin(), only_tests.end(), t.name) == only_tests.end(); });
+  }
   check_every_test(case_file, options, samples, only_samples, tests, failure.has_value(), references);
   if (failure) return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, *failure);
 

@@ -193,13 +193,15 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
 // constants are tabulated next to the closed forms (app/micromechanics.hpp) and the
 // references, whose missing entries are left blank; tests without a modulus_estimate take the
 // closed form's (E_T for L and T, G_LT, G_TT': the slowest motion of each test).
-// Reads the case of every sample (or only those named in only_samples) x test first, so that a
+// Reads the case of every sample (or only those named in only_samples) x test (or only those named
+// in only_tests) first, so that a
 // bad override or a reference to a bond set the case lacks is an InputError before any run;
 // then runs each into out_dir/<sample>/<test>/, prints one line per test and the tables, and writes out_dir/tests.csv and (with composite)
 // out_dir/composite.md. options' overrides apply to the case before the sample's. Returns the
 // number of runs that stopped (0: all measured).
 int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOptions& options,
-                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples = {});
+                           const std::filesystem::path& out_dir, const std::vector<std::string>& only_samples = {},
+                           const std::vector<std::string>& only_tests = {});
 
 // Reads a virtual-test spec as run_virtual_test_suite does, without building a scene; InputError
 // at the key.

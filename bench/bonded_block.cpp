@@ -1,19 +1,33 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Bonded-block benchmark (docs/validation.md R9): the case cases/bonded_block_tension (20 x 20 x 50
-// spheres, ~57 600 beam bonds, bottom fixed, top pulled at 0.1 m/s, dt = 1e-7 s), 2000 steps
-// with no output, for 1 and 2 OpenMP threads. Prints setup time, step time, particle-steps/s,
-// bond-steps/s and memory. Usage: bench_bonded_block [steps] [case.yaml]
+// Bonded-block benchmark (docs/validation.md R9, docs/performance.md): by default the case
+// cases/bonded_block_tension (20 x 20 x 50 spheres, ~57 600 beam bonds, bottom fixed, top pulled
+// at 0.1 m/s), 2000 steps with no output, on 1 and 2 OpenMP threads. Prints setup time, step
+// time, particle-steps/s, bond-steps/s and memory; with --repeat R the thread counts alternate R
+// times and the medians are printed; with --profile the phases of the step on each thread count
+// against one thread (common/step_profile.hpp).
+// The same for a virtual test run to its end (the REV failure test): --virtual-test SPEC --sample
+// NAME --test NAME times the test's time loop (sensors and rows included) the same way.
+// Usage: bench_bonded_block [--steps N] [--threads 1,2,4,...] [--repeat R] [--profile] [CASE.yaml]
+//        bench_bonded_block --virtual-test SPEC --sample NAME --test NAME [--threads ...] [--repeat R] [--profile]
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "app/scene.hpp"
+#include "app/virtual_tests.hpp"
+#include "common/error.hpp"
+#include "common/step_profile.hpp"
 
 namespace {
 
@@ -31,49 +45,141 @@ std::pair<double, double> memory_bytes() {
   return {rss * 1024.0, peak * 1024.0};
 }
 
+struct Options {
+  long steps = 2000;
+  std::vector<int> threads{1, 2};
+  int repeat = 1;
+  bool profile = false;
+  std::string case_file = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/bonded_block_tension/case.yaml";
+  std::string spec, sample, test;  // --virtual-test
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int k = 1; k < argc; ++k) {
+    const std::string arg = argv[k];
+    const auto value = [&] {
+      if (k + 1 >= argc) throw arlequin::InputError(arg + ": expected a value after it");
+      return std::string(argv[++k]);
+    };
+    if (arg == "--steps") o.steps = std::stol(value());
+    else if (arg == "--repeat") o.repeat = std::max(1, std::stoi(value()));
+    else if (arg == "--profile") o.profile = true;
+    else if (arg == "--virtual-test") o.spec = value();
+    else if (arg == "--sample") o.sample = value();
+    else if (arg == "--test") o.test = value();
+    else if (arg == "--threads") {
+      o.threads.clear();
+      std::stringstream list(value());
+      for (std::string item; std::getline(list, item, ',');) o.threads.push_back(std::stoi(item));
+      if (o.threads.empty() || o.threads.front() != 1) o.threads.insert(o.threads.begin(), 1);  // the reference
+    } else if (!arg.starts_with("-")) o.case_file = arg;
+    else throw arlequin::InputError("bench_bonded_block: unknown option '" + arg + "'");
+  }
+  if (!o.spec.empty() && (o.sample.empty() || o.test.empty()))
+    throw arlequin::InputError("--virtual-test needs --sample NAME and --test NAME");
+  return o;
+}
+
+struct Timing {
+  double seconds = 0.0;  // the time loop
+  double work = 0.0;     // bond-steps (block) or steps (virtual test)
+};
+
+// The block: build the case, run its steps with no output.
+Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, bool first) {
+  const double rss_before = memory_bytes().first;
+  const auto t0 = Clock::now();
+  arlequin::app::Scene scene = arlequin::app::build_scene(o.case_file, {});
+  const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double rss_built = memory_bytes().first;
+  const double n = double(scene.dem.particles.size());
+  double bonds = 0;
+  for (const auto& set : scene.dem.bond_sets()) bonds += double(set->size());
+  scene.dem.set_profile(profile);
+  const auto t1 = Clock::now();
+  for (long s = 0; s < o.steps; ++s) {
+    scene.dem.step(scene.dt);
+    if (profile) profile->count_step();
+  }
+  const double run = std::chrono::duration<double>(Clock::now() - t1).count();
+  scene.dem.set_profile(nullptr);
+  std::printf("threads %d: DEs %.0f, bonds %.0f, setup %.3f s, %ld steps %.3f s (%.3f ms/step), "
+              "particle-steps/s %.3e, bond-steps/s %.3e\n",
+              threads, n, bonds, setup, o.steps, run, 1e3 * run / o.steps, n * o.steps / run, bonds * o.steps / run);
+  if (first)
+    std::printf("  memory: scene %.1f MB resident = %.0f B per DE + bond pair (%.0f B/DE if all charged to DEs, "
+                "%.0f B/bond if all to bonds); peak RSS %.1f MB\n",
+                (rss_built - rss_before) / 1e6, (rss_built - rss_before) / (n + bonds), (rss_built - rss_before) / n,
+                (rss_built - rss_before) / bonds, memory_bytes().second / 1e6);
+  return {run, bonds * o.steps};
+}
+
+// A virtual test to its end; the time loop's wall time is the profile's (always attached).
+Timing run_virtual_test(const Options& o, int threads, arlequin::StepProfile& profile) {
+  const auto out = std::filesystem::temp_directory_path() / "bench_bonded_block_virtual_test";
+  std::filesystem::remove_all(out);
+  arlequin::app::SceneOptions options;
+  options.profile = &profile;
+  const double before = profile.seconds();
+  const long steps_before = profile.steps();
+  arlequin::app::run_virtual_test_suite(o.spec, options, out, {o.sample}, {o.test});
+  const double run = profile.seconds() - before;
+  const long steps = profile.steps() - steps_before;
+  std::printf("threads %d: %s %s, %ld steps %.3f s (%.3f ms/step)\n", threads, o.sample.c_str(), o.test.c_str(), steps,
+              run, 1e3 * run / double(std::max(steps, 1L)));
+  return {run, double(steps)};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
 }  // namespace
 
-int main(int argc, char** argv) {
-  const long steps = argc > 1 ? std::atol(argv[1]) : 2000;
-  const std::string case_file =
-      argc > 2 ? argv[2] : std::string(ARLEQUIN_SOURCE_DIR) + "/cases/bonded_block_tension/case.yaml";
-  std::printf("bonded block benchmark: %s, %ld steps, no output\n", case_file.c_str(), steps);
+int main(int argc, char** argv) try {
+  const Options o = parse(argc, argv);
+  const bool virtual_test = !o.spec.empty();
+  if (virtual_test)
+    std::printf("virtual-test benchmark: %s, sample %s, test %s\n", o.spec.c_str(), o.sample.c_str(), o.test.c_str());
+  else
+    std::printf("bonded block benchmark: %s, %ld steps, no output\n", o.case_file.c_str(), o.steps);
   // Bytes the structure-of-arrays layout stores per DE and per beam bond (fields of
   // ParticleSet; BeamBondSet: two indices, L0, three stiffnesses, two unit vectors).
   using arlequin::Quat;
   using arlequin::Vec3;
   constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 2 * sizeof(double) + sizeof(arlequin::dem::GroupMask);
   constexpr std::size_t per_bond = 2 * sizeof(std::uint32_t) + 4 * sizeof(double) + 2 * sizeof(Vec3);
-  std::printf("layout: %zu B per DE, %zu B per beam bond (targets <= 200, <= 150)\n", per_de, per_bond);
-  double one_thread_rate = 0.0;
-  for (int threads : {1, 2}) {
+  if (!virtual_test) std::printf("layout: %zu B per DE, %zu B per beam bond (targets <= 200, <= 150)\n", per_de, per_bond);
+  std::map<int, std::vector<double>> rates;  // work per second of each run, by thread count
+  std::map<int, arlequin::StepProfile> profiles;
+  for (int r = 0; r < o.repeat; ++r)
+    for (int threads : o.threads) {
 #ifdef _OPENMP
-    omp_set_num_threads(threads);
+      omp_set_num_threads(threads);
 #else
-    if (threads > 1) break;  // built without OpenMP: one thread only
+      if (threads > 1) continue;  // built without OpenMP: one thread only
 #endif
-    const double rss_before = memory_bytes().first;
-    const auto t0 = Clock::now();
-    arlequin::app::Scene scene = arlequin::app::build_scene(case_file, {});
-    const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
-    const double rss_built = memory_bytes().first;
-    const double n = double(scene.dem.particles.size());
-    double bonds = 0;
-    for (const auto& set : scene.dem.bond_sets()) bonds += double(set->size());
-
-    const auto t1 = Clock::now();
-    for (long s = 0; s < steps; ++s) scene.dem.step(scene.dt);
-    const double run = std::chrono::duration<double>(Clock::now() - t1).count();
-    const double bond_rate = bonds * steps / run;
-    if (threads == 1) one_thread_rate = bond_rate;
-    std::printf("threads %d: DEs %.0f, bonds %.0f, setup %.3f s, %ld steps %.3f s (%.3f ms/step)\n", threads, n,
-                bonds, setup, steps, run, 1e3 * run / steps);
-    std::printf("  particle-steps/s %.3e   bond-steps/s %.3e   speed-up vs 1 thread %.2f\n", n * steps / run,
-                bond_rate, bond_rate / one_thread_rate);
-    std::printf("  memory: scene %.1f MB resident = %.0f B per DE + bond pair (%.0f B/DE if all charged to DEs, "
-                "%.0f B/bond if all to bonds); peak RSS %.1f MB\n",
-                (rss_built - rss_before) / 1e6, (rss_built - rss_before) / (n + bonds),
-                (rss_built - rss_before) / n, (rss_built - rss_before) / bonds, memory_bytes().second / 1e6);
+      arlequin::StepProfile& profile = profiles[threads];
+      const Timing t = virtual_test ? run_virtual_test(o, threads, profile)
+                                    : run_block(o, threads, o.profile ? &profile : nullptr, r == 0 && threads == o.threads.front());
+      rates[threads].push_back(t.work / t.seconds);
+    }
+  const double one = median(rates[1]);
+  std::printf("median of %d run(s) per thread count, alternated:\n", o.repeat);
+  for (const auto& [threads, list] : rates)
+    std::printf("  threads %2d: %s %.3e  speed-up vs 1 thread %.2fx\n", threads, virtual_test ? "steps/s" : "bond-steps/s",
+                median(list), median(list) / one);
+  if (o.profile) {
+    for (const auto& [threads, profile] : profiles) {
+      if (threads == 1) std::printf("\n%s", profile.table().c_str());
+      else std::printf("\n%s", arlequin::StepProfile::comparison(profiles[1], profile, threads).c_str());
+    }
   }
   return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "bench_bonded_block: %s\n", e.what());
+  return 2;
 }

@@ -35,10 +35,24 @@ inline constexpr long parallel_threshold_bond_particles = 2048;
 // several such regions, and paid for them a third of its time. Not for
 // use inside a parallel region: an orphaned loop there would split over the enclosing team, or
 // hang if only some of its threads reach it (none of ours nests).
+// The threads an OpenMP loop may use (1 without OpenMP).
+inline int max_threads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+// Whether a loop asked to run `threaded` does run on more than one thread.
+inline bool runs_threaded(bool threaded) {
+  return threaded && max_threads() > 1;
+}
+
 template <class Loop>
 void run_threaded_if(bool threaded, Loop&& loop) {
 #ifdef _OPENMP
-  if (threaded && omp_get_max_threads() > 1) {
+  if (runs_threaded(threaded)) {
 #pragma omp parallel
     loop();
     return;

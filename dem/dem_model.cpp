@@ -90,6 +90,11 @@ void DemModel::finalize() {
     }
   }
   constraint_reaction_.assign(constraints_.size(), Vec3{});
+  condition_velocity_.assign(boundaries_.size(), Vec3{});
+  watched_members_.clear();
+  for (std::size_t i = 0; i < particles.size(); ++i)
+    for (GroupMask m = particles.groups[i] & watched_; m; m &= m - 1)
+      watched_members_.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(std::countr_zero(m))});
   driven_.assign(particles.size(), 0);
   for (const Constraint& c : constraints_) {
     const BoundaryCondition& bc = boundaries_[c.condition];
@@ -151,6 +156,26 @@ double DemModel::critical_time_step() const {
   return dt_c;
 }
 
+void DemModel::set_profile(StepProfile* profile) {
+  profile_ = profile;
+  if (!profile) return;
+  phase_.kick = profile->phase("kicks");
+  phase_.drift = profile->phase("drift");
+  phase_.clear = profile->phase("clear forces");
+  phase_.boundary = profile->phase("boundary conditions");
+  if (neighbours_) phase_.neighbours = profile->phase("neighbour list");
+  phase_.bonds.clear();
+  for (const auto& set : bond_sets_) {
+    const std::string pass = set->colours() > 0 ? std::to_string(set->colours()) + " colours" : "gather";
+    phase_.bonds.push_back(profile->phase("bonds " + set->name + " (" + std::string(set->law()) + ", " + pass + ")"));
+  }
+  if (contact_) phase_.contacts = profile->phase("contacts");
+  if (failure_on_) phase_.failure = profile->phase("failure scan and breaks");
+  if (watched_) phase_.reactions = profile->phase("group reactions");
+  phase_.loads = profile->phase("loads and damping");
+  phase_.finite = profile->phase("finite check");
+}
+
 void DemModel::step(double dt) {
   advance_to_forces(dt);
   finish_step(dt);
@@ -158,14 +183,31 @@ void DemModel::step(double dt) {
 
 void DemModel::advance_to_forces(double dt) {
   last_dt_ = dt;
-  // Work of kinematic conditions = the driven DEs' kinetic energy change (here and at the
-  // end of the step) + the work of their reactions (record_reactions).
-  external_work_ -= driven_kinetic_energy();
-  kick(0.5 * dt);                     // v(n+1/2) = v(n) + dt/2 a(n)
-  impose_motion(time_, true, dt);     // driven DEs move exactly by u(t+dt) - u(t)
-  drift(dt);                          // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
+  const long n = static_cast<long>(particles.size());
+  const bool particles_threaded = runs_threaded(n > parallel_threshold);
+  {
+    // Work of kinematic conditions = the driven DEs' kinetic energy change (here and at the
+    // end of the step) + the work of their reactions (record_reactions).
+    const PhaseTimer timer(profile_, phase_.boundary, false);
+    external_work_ -= driven_kinetic_energy();
+  }
+  {
+    const PhaseTimer timer(profile_, phase_.kick, particles_threaded);
+    kick(0.5 * dt);                   // v(n+1/2) = v(n) + dt/2 a(n)
+  }
+  {
+    const PhaseTimer timer(profile_, phase_.boundary, false);
+    impose_motion(time_, true, dt);   // driven DEs move exactly by u(t+dt) - u(t)
+  }
+  {
+    const PhaseTimer timer(profile_, phase_.drift, particles_threaded);
+    drift(dt);                        // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
+  }
   time_ += dt;
-  update_neighbours();                // only with contact, only when a DE moved > skin/2
+  {
+    const PhaseTimer timer(profile_, phase_.neighbours, false);
+    update_neighbours();              // only with contact, only when a DE moved > skin/2
+  }
   // Bonds, contacts -> f(n+1); breakable: also each bond's failure measure or virial; before
   // an output row: also each bond's energy.
   ForceScan scan = failure_on_ ? failure_scan() : ForceScan{};
@@ -175,11 +217,18 @@ void DemModel::advance_to_forces(double dt) {
   if (failure_on_) apply_failures(scan.energy);  // BBF / RDEF: break bonds, forces again if any broke
   energy_record_step_ = scan.energy ? steps_ + 1 : -1;
   record_reactions();                 // for sensors, and the work of driven DEs
-  apply_loads_and_damping();          // dead loads, viscous damping
+  {
+    const PhaseTimer timer(profile_, phase_.loads, particles_threaded && damping_ > 0.0);
+    apply_loads_and_damping();        // dead loads, viscous damping
+  }
 }
 
 void DemModel::finish_step(double dt) {
-  kick(0.5 * dt);                     // v(n+1) = v(n+1/2) + dt/2 a(n+1)
+  {
+    const PhaseTimer timer(profile_, phase_.kick, runs_threaded(static_cast<long>(particles.size()) > parallel_threshold));
+    kick(0.5 * dt);                   // v(n+1) = v(n+1/2) + dt/2 a(n+1)
+  }
+  const PhaseTimer timer(profile_, phase_.boundary, false);
   impose_motion(time_, false, dt);    // driven DEs: v = du/dt(t(n+1))
   external_work_ += driven_kinetic_energy();
   ++steps_;
@@ -219,9 +268,15 @@ void DemModel::kick(double half_dt) {
 }
 
 void DemModel::impose_motion(double t, bool half_step, double dt) {
+  // Each condition's velocity once, then its DEs'.
+  for (std::size_t k = 0; k < boundaries_.size(); ++k) {
+    const BoundaryCondition& bc = boundaries_[k];
+    if (bc.kinematic())
+      condition_velocity_[k] = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+  }
   for (const Constraint& c : constraints_) {
     const BoundaryCondition& bc = boundaries_[c.condition];
-    const Vec3 v = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
+    const Vec3& v = condition_velocity_[c.condition];
     for (int k = 0; k < 3; ++k)
       if (bc.components[k]) particles.velocity[c.particle][k] = v[k];
     if (bc.lock_rotation) particles.angular_velocity[c.particle] = {};
@@ -255,9 +310,16 @@ void DemModel::update_neighbours() {
 }
 
 double DemModel::compute_forces(const ForceScan& scan) {
-  particles.clear_forces();
-  for (const auto& set : bond_sets_) set->accumulate_forces(particles, scan);
+  {
+    const PhaseTimer timer(profile_, phase_.clear, runs_threaded(static_cast<long>(particles.size()) > parallel_threshold));
+    particles.clear_forces();
+  }
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+    const PhaseTimer timer(profile_, profile_ ? phase_.bonds[s] : 0, runs_threaded(bond_sets_[s]->runs_on_threads()));
+    bond_sets_[s]->accumulate_forces(particles, scan);
+  }
   if (!contact_) return 0.0;
+  const PhaseTimer timer(profile_, phase_.contacts, false);
   std::fill(touching_.begin(), touching_.end(), 0u);
   deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles, touching_);
   return deepest_contact_.friction_power;
@@ -279,11 +341,21 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> DemModel::intact_bonded_pai
 }
 
 void DemModel::apply_failures(bool record_energy) {
+  {
+    const PhaseTimer timer(profile_, phase_.failure, false);
+    if (!break_failed_bonds()) return;
+  }
+  ForceScan scan;
+  scan.energy = record_energy;
+  compute_forces(scan);
+}
+
+bool DemModel::break_failed_bonds() {
   new_breaks_.clear();
   for (std::size_t s = 0; s < bond_sets_.size(); ++s)
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) rdef_->find_failures(particles, bond_sets_, time_, new_breaks_);
-  if (new_breaks_.empty()) return;
+  if (new_breaks_.empty()) return false;
   for (const BreakEvent& e : new_breaks_) {
     BondSet& set = *bond_sets_[e.set];
     if (set.broken()[e.bond]) continue;  // reported twice (BBF and RDEF): break once
@@ -297,9 +369,7 @@ void DemModel::apply_failures(bool record_energy) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
   }
-  ForceScan scan;
-  scan.energy = record_energy;
-  compute_forces(scan);
+  return true;
 }
 
 std::vector<Sym3> DemModel::virial_stress(double compaction) const {
@@ -325,11 +395,11 @@ std::vector<double> DemModel::damage() const {
 void DemModel::record_reactions() {
   const ParticleSet& p = particles;
   if (watched_) {
+    const PhaseTimer timer(profile_, phase_.reactions, false);
     for (auto& r : reaction_) r = {};
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      for (GroupMask m = p.groups[i] & watched_; m; m &= m - 1) reaction_[std::countr_zero(m)] -= p.force[i];
-    }
+    for (const auto& [i, group] : watched_members_) reaction_[group] -= p.force[i];
   }
+  const PhaseTimer timer(profile_, phase_.boundary, false);
   // Reaction R = -(bond + contact forces) on each driven DE; over the drift it did the
   // trapezoidal work (R(n) + R(n+1))/2 . dt v(n+1/2).
   // Only the imposed components: forces along free ones move the DE like any other.
@@ -352,15 +422,17 @@ void DemModel::apply_loads_and_damping() {
     external_work_ += dot(load_per_particle_[k], p.velocity[i]) * last_dt_;
   }
   if (damping_ > 0.0) {
-    // Viscous damping from the half-step velocity, none on imposed components.
-    for (std::size_t i = 0; i < p.size(); ++i) {
+    // Viscous damping from the half-step velocity, none on imposed components; split over the
+    // threads as the kicks.
+    const long n = static_cast<long>(p.size());
+    for_each_index(n, n > parallel_threshold, [&](long i) {
       damping_force_[i] = p.velocity[i] * (-damping_ * p.mass(i));
       for (int k = 0; k < 3; ++k)
         if (driven_[i] & (1 << k)) damping_force_[i][k] = 0.0;
       damping_torque_[i] = (driven_[i] & 8) ? Vec3{} : p.angular_velocity[i] * (-damping_ * p.inertia(i));
       p.force[i] += damping_force_[i];
       p.torque[i] += damping_torque_[i];
-    }
+    });
   }
 }
 
@@ -445,6 +517,14 @@ Vec3 DemModel::mean_velocity(int group) const {
 
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
+  const long n = static_cast<long>(p.size());
+  const PhaseTimer timer(profile_, phase_.finite, !contact_ && runs_threaded(n > parallel_threshold));
+  // Without contact only non-finite velocities count: a count on the threads, split as the
+  // kicks, and the serial pass below only to name the first of them.
+  if (!contact_ && fixed_order_sum(n, parallel_threshold, check_partial_, [&p](long i) {
+        return is_finite(p.velocity[i]) && is_finite(p.angular_velocity[i]) ? 0.0 : 1.0;
+      }) == 0.0)
+    return;
   std::size_t bad = 0, first = 0;
   ContactResolution worst;  // with contact
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/step_profile.hpp"
 #include "dem/bonds/bond_set.hpp"
 #include "dem/boundary.hpp"
 #include "dem/contacts/contact_law.hpp"
@@ -57,7 +58,7 @@ class DemModel {
   std::vector<std::uint32_t> driven_particles() const;
   // Viscous damping, force -c m v and torque -c I omega, c in 1/s (quasi-static runs).
   void set_damping(double coefficient) { damping_ = coefficient; }
-  // Reaction forces of this group are recorded every step (for force sensors).
+  // Reaction forces of this group are recorded every step (for force sensors); before finalize().
   void watch_reaction(int group) { watched_ |= GroupMask{1} << group; }
 
   // Arlequin weighting (docs/theory.md#weighted-models): every DE's mass (and so its inertia) is
@@ -85,6 +86,8 @@ class DemModel {
   void step(double dt);
   void advance_to_forces(double dt);  // kick dt/2, drift dt, forces at t + dt
   void finish_step(double dt);        // kick dt/2 to the velocities at t + dt
+  // Times the step's phases into `profile` from now on (nullptr: stops); after finalize().
+  void set_profile(StepProfile* profile);
   double time() const { return time_; }
   long steps_done() const { return steps_; }
 
@@ -153,6 +156,7 @@ class DemModel {
   ForceScan failure_scan();
   void record_reactions();
   void apply_failures(bool record_energy);  // record_energy: the forces' recomputation records too
+  bool break_failed_bonds();                // apply_failures' breaks; false: none failed
   // Makes the bond sets' energy records those of the current configuration (a pass over the
   // bonds unless the last step's force pass recorded them).
   void use_energy_record() const;
@@ -176,6 +180,9 @@ class DemModel {
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
+  std::vector<Vec3> condition_velocity_;   // scratch of impose_motion: per boundary condition, m/s
+  // (DE, group) for every DE of a watched group, in DE order: record_reactions' sums.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> watched_members_;
   std::vector<Constraint> loaded_;       // force loads, one entry per (DE, load)
   std::vector<Vec3> load_per_particle_;  // N, per entry of loaded_
   std::optional<RdefCriterion> rdef_;
@@ -183,6 +190,7 @@ class DemModel {
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
+  mutable std::vector<double> check_partial_;  // scratch: check_finite's chunk counts
   bool energy_record_requested_ = false;  // record_energies_in_next_step()
   long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
   mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE
@@ -190,6 +198,12 @@ class DemModel {
   Vec3 reaction_[max_groups]{};
   double damping_ = 0.0;
   std::vector<Vec3> damping_force_, damping_torque_;  // this step's, kept for both half kicks
+  // The step's phases in profile_ (set_profile), one per bond set in bonds.
+  StepProfile* profile_ = nullptr;
+  struct ProfilePhases {
+    int kick, drift, clear, boundary, neighbours, contacts, failure, reactions, loads, finite;
+    std::vector<int> bonds;
+  } phase_{};
   std::vector<std::uint8_t> driven_;  // per DE: bits 0-2 imposed x, y, z; bit 3 rotation locked
   double time_ = 0.0;
   double last_dt_ = 0.0;  // s, step size of the step in progress (0 before the first)

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <numbers>
 
+#include "common/parallel.hpp"
+
 namespace arlequin::dem {
 
 std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
@@ -22,8 +24,9 @@ std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
 }
 
 void ParticleSet::clear_forces() {
-  std::fill(force.begin(), force.end(), Vec3{});
-  std::fill(torque.begin(), torque.end(), Vec3{});
+  // On the threads, split as the kicks and the drift, so each thread clears the DEs it updates.
+  const long n = static_cast<long>(size());
+  for_each_index(n, n > parallel_threshold, [this](long i) { force[i] = torque[i] = Vec3{}; });
 }
 
 void ParticleSet::move_entry(std::size_t from, std::size_t to) {

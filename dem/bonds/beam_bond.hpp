@@ -53,7 +53,13 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   static std::span<const KeyDoc> keys();  // what make() reads
 
   void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) override;
-  // The SIMD block pass (below), recording each bond as BondKernelSet's per-bond pass does.
+  // Orders the bonds by (first, second) DE (no colours) and lists each DE's bond ends.
+  void finalize(std::size_t n_particles) override;
+  // The gather pass: every bond's actions are computed by the SIMD block kernel (below) and
+  // stored, then every DE adds those of its bonds in bond order, on the threads split as the
+  // kicks: no two threads write one DE without colours, one barrier per pass instead of one per
+  // colour, and sums that do not depend on the thread count. It records what BondKernelSet's
+  // per-bond pass records (the virial per DE, in bond order, as accumulate_virial).
   void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
 
   // The generalised forces of bond b in the current configuration (for tests, sensors and
@@ -117,6 +123,13 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   // a block of consecutive bonds loads each component as one vector, like the scalars above.
   std::array<std::vector<double>, 3> direction_;
   std::array<std::vector<double>, 3> normal_;
+  // The gather pass: bonded_ lists the DEs with a bond of the set, in order; bonded_[k]'s bond
+  // ends are end_bonds_[end_offsets_[k] .. end_offsets_[k + 1]), each 2 b + 0 where it is bond
+  // b's first DE, 2 b + 1 where it is its second, in bond order.
+  std::vector<std::uint32_t> bonded_, end_offsets_, end_bonds_;
+  // Scratch of the gather pass, one array per component of the force on j, the torque on i and
+  // the torque on j (9 arrays, one writer per bond), sized to whole blocks.
+  mutable std::array<std::vector<double>, 9> bond_actions_;
 };
 
 extern template class BondKernelSet<BeamBondSet>;

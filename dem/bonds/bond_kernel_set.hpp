@@ -26,9 +26,11 @@
 //   double event_mode_mix(b, const Evaluation&) const;  a failure's mode mix (else none)
 // commit is called by the force pass only, after each evaluation, so evaluate() stays a pure
 // function of the configuration and the stored history.
-// A law with a faster pass of its own (the beam's SIMD blocks) overrides accumulate_forces and
-// records each bond with record_scan, so both passes record the same.
+// A law with a faster pass of its own (the beam's SIMD blocks and gather) overrides
+// accumulate_forces and records what record_scan records (the virial through add_bond_end_virial,
+// in bond order per DE, so that it has accumulate_virial's bits).
 #pragma once
+#include <atomic>
 #include <stdexcept>
 #include <string>
 
@@ -88,16 +90,23 @@ class BondKernelSet : public BondSet {
   // scatters without races, in accumulate_virial's order; the bond pulls i with -force_on_j.
   template <class Evaluation>
   void record_scan(std::size_t b, const Evaluation& e, ParticleSet& p, const ForceScan& scan, const Records& r) const {
-    if (r.criterion) measure_[b] = self().failure_measure(b, e);
+    if (r.criterion) note_measure(b, self().failure_measure(b, e));
     if (r.energy) energy_record_[b] = self().energy_of(b, e);
     if (r.virial && !broken_[b]) add_bond_virial(p, first_[b], second_[b], -Law::force_on_j(e), scan.branch, scan.virial);
   }
 
   void zero_stiffness(std::size_t b) override;
 
+  // Records bond b's failure measure; an intact bond at its strength raises failing_, so that
+  // find_failures scans the bonds only after a pass where one may fail.
+  void note_measure(std::size_t b, double measure) const {
+    measure_[b] = measure;
+    if (measure >= self().strength() && !broken_[b]) failing_.store(true, std::memory_order_relaxed);
+  }
   // Each bond's failure measure from the last force pass with ForceScan::criterion (scratch
   // sized by finalize; one writer per bond).
   mutable std::vector<double> measure_;
+  mutable std::atomic<bool> failing_{false};
 
  private:
   const Law& self() const { return static_cast<const Law&>(*this); }
@@ -169,6 +178,7 @@ void BondKernelSet<Law>::find_failures(const ParticleSet& p, std::uint32_t set_i
                                        std::vector<BreakEvent>& events) const {
   if (!has_strength()) return;
   if (measure_.size() != size()) throw std::logic_error(std::string(Law::name) + " bonds: added after finalize()");
+  if (!failing_.exchange(false, std::memory_order_relaxed)) return;
   const double strength = self().strength();
   for (std::size_t b = 0; b < size(); ++b) {
     if (broken_[b] || measure_[b] < strength) continue;

@@ -41,20 +41,37 @@ std::vector<std::uint32_t> BondColouring::build(std::span<const std::uint32_t> f
   offsets.assign(n_colours + 1, 0);
   for (std::size_t b = 0; b < n; ++b) ++offsets[colour[b] + 1];
   std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  threaded = long(n) > n_colours * parallel_threshold_bonds && long(n_particles) > parallel_threshold_bond_particles;
+  threaded = worth_threads(n, n_colours, n_particles);
   return order;
 }
 
-void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
-                     std::span<Sym3> virial) {
+std::vector<std::uint32_t> BondSet::order_pairs_by_first(std::size_t n_particles) {
+  std::vector<std::uint32_t> order(size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return first_[a] != first_[b] ? first_[a] < first_[b] : second_[a] < second_[b];
+  });
+  apply_pair_order(order);
+  colouring_.offsets.clear();
+  colouring_.threaded = BondColouring::worth_threads(size(), 1, n_particles);
+  return order;
+}
+
+void add_bond_end_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                         int end, Sym3& virial) {
   const Vec3 r = p.position[j] - p.position[i];
   double share_i = 1.0;  // 2 d_i / d
   if (branch == VirialBranch::radical) {
     const double d2 = norm2(r), ri = p.radius[i], rj = p.radius[j];
     share_i = (d2 + ri * ri - rj * rj) / d2;
   }
-  add_symmetric_product(virial[i], share_i * r, f_i);
-  add_symmetric_product(virial[j], (2.0 - share_i) * r, f_i);
+  add_symmetric_product(virial, (end == 0 ? share_i : 2.0 - share_i) * r, f_i);
+}
+
+void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                     std::span<Sym3> virial) {
+  add_bond_end_virial(p, i, j, f_i, branch, 0, virial[i]);
+  add_bond_end_virial(p, i, j, f_i, branch, 1, virial[j]);
 }
 
 double BondSet::recorded_energy() const {

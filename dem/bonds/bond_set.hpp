@@ -37,6 +37,9 @@ struct BondColouring {
   // The colours run on threads: more than parallel_threshold_bonds bonds per colour on
   // average, in a scene of more than parallel_threshold_bond_particles DEs (set by build).
   bool threaded = false;
+  static bool worth_threads(std::size_t bonds, std::size_t colours, std::size_t n_particles) {
+    return long(bonds) > long(colours) * parallel_threshold_bonds && long(n_particles) > parallel_threshold_bond_particles;
+  }
 
   // Greedy edge colouring of (first, second) in a scene of n_particles DEs; returns the
   // permutation that sorts bonds by (colour, first), fills offsets and sets threaded. At most
@@ -87,6 +90,10 @@ void for_each_bond(const BondColouring& colouring, Body&& body) {
 // into fused multiply-adds.
 void add_bond_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
                      std::span<Sym3> virial);
+// The same bond's term of one end's DE only (end 0: i, 1: j), added to `virial` (that DE's):
+// add_bond_virial is this for both ends, so a pass that sums per DE gets the same bits.
+void add_bond_end_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,
+                         int end, Sym3& virial);
 
 // What a force pass records besides forces, for the failure check of the same configuration
 // (DemModel::apply_failures) and for the energies of an output row.
@@ -162,6 +169,7 @@ class BondSet {
   std::span<const std::uint32_t> second() const { return second_; }
   // The force pass runs the colours on the OpenMP threads there are (BondColouring::threaded).
   bool runs_on_threads() const { return colouring_.threaded; }
+  std::size_t colours() const { return colouring_.offsets.empty() ? 0 : colouring_.offsets.size() - 1; }
   std::string name;  // the bonds' group (e.g. fibre, matrix, interface), for records and output
 
  protected:
@@ -175,12 +183,13 @@ class BondSet {
   // for the law's arrays.
   std::vector<std::uint32_t> order_pairs(std::size_t n_particles) {
     auto order = colouring_.build(first_, second_, n_particles);
-    apply_order(first_, order);
-    apply_order(second_, order);
-    apply_order(broken_, order);
-    apply_order(energy_record_, order);
+    apply_pair_order(order);
     return order;
   }
+  // For a law that gathers instead (BeamBondSet): no colours; the pairs sorted by (first,
+  // second), so that a DE's bonds, and those of its neighbours in numbering, lie together.
+  // colouring_.threaded by the same scene-size rule, with all bonds as one colour.
+  std::vector<std::uint32_t> order_pairs_by_first(std::size_t n_particles);
   // record_energies(): energy_record_[b] = bond_energy(b) for every bond (finalized or not:
   // each bond writes only its own entry, so no colouring is needed; on threads when the force
   // pass is, by the same scene-size rule).
@@ -188,6 +197,12 @@ class BondSet {
   void record_each(BondEnergy&& bond_energy) const {
     for_each_index(static_cast<long>(size()), colouring_.threaded,
                    [&](long b) { energy_record_[b] = bond_energy(static_cast<std::size_t>(b)); });
+  }
+  void apply_pair_order(std::span<const std::uint32_t> order) {
+    apply_order(first_, order);
+    apply_order(second_, order);
+    apply_order(broken_, order);
+    apply_order(energy_record_, order);
   }
   virtual void zero_stiffness(std::size_t b) = 0;
   // What the law's bonds remember beyond broken or intact (a cohesive link's damage): none by
