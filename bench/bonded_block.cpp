@@ -7,8 +7,8 @@
 // against one thread (common/step_profile.hpp).
 // The same for a virtual test run to its end (the REV failure test): --virtual-test SPEC --sample
 // NAME --test NAME times the test's time loop (sensors and rows included) the same way.
-// Usage: bench_bonded_block [--steps N] [--threads 1,2,4,...] [--repeat R] [--profile] [CASE.yaml]
-//        bench_bonded_block --virtual-test SPEC --sample NAME --test NAME [--threads ...] [--repeat R] [--profile]
+// Usage: bench_bonded_block [--steps N] [--threads 1,2,4,...] [--repeat R] [--profile] [--set k=v ...] [CASE.yaml]
+//        bench_bonded_block --virtual-test SPEC --sample NAME --test NAME [--threads ...] [--repeat R] [--profile] [--set k=v ...]
 #ifdef _OPENMP
 #include <omp.h>
 #endif
@@ -18,7 +18,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -45,6 +47,14 @@ std::pair<double, double> memory_bytes() {
   return {rss * 1024.0, peak * 1024.0};
 }
 
+// FNV-1a of bytes: a fingerprint of a run's result, equal on every thread count when the run's
+// results are the same to the bit.
+std::uint64_t fingerprint(const void* data, std::size_t bytes, std::uint64_t hash = 1469598103934665603ull) {
+  const auto* c = static_cast<const unsigned char*>(data);
+  for (std::size_t k = 0; k < bytes; ++k) hash = (hash ^ c[k]) * 1099511628211ull;
+  return hash;
+}
+
 struct Options {
   long steps = 2000;
   std::vector<int> threads{1, 2};
@@ -52,6 +62,7 @@ struct Options {
   bool profile = false;
   std::string case_file = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/bonded_block_tension/case.yaml";
   std::string spec, sample, test;  // --virtual-test
+  std::vector<arlequin::Override> overrides;  // --set key=value, on the case
 };
 
 Options parse(int argc, char** argv) {
@@ -68,6 +79,7 @@ Options parse(int argc, char** argv) {
     else if (arg == "--virtual-test") o.spec = value();
     else if (arg == "--sample") o.sample = value();
     else if (arg == "--test") o.test = value();
+    else if (arg == "--set") o.overrides.push_back(value());
     else if (arg == "--threads") {
       o.threads.clear();
       std::stringstream list(value());
@@ -90,7 +102,9 @@ struct Timing {
 Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, bool first) {
   const double rss_before = memory_bytes().first;
   const auto t0 = Clock::now();
-  arlequin::app::Scene scene = arlequin::app::build_scene(o.case_file, {});
+  arlequin::app::SceneOptions options;
+  options.overrides = o.overrides;
+  arlequin::app::Scene scene = arlequin::app::build_scene(o.case_file, options);
   const double setup = std::chrono::duration<double>(Clock::now() - t0).count();
   const double rss_built = memory_bytes().first;
   const double n = double(scene.dem.particles.size());
@@ -104,9 +118,13 @@ Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, 
   }
   const double run = std::chrono::duration<double>(Clock::now() - t1).count();
   scene.dem.set_profile(nullptr);
+  const auto& p = scene.dem.particles;
+  const std::uint64_t print = fingerprint(p.velocity.data(), p.size() * sizeof(arlequin::Vec3),
+                                          fingerprint(p.position.data(), p.size() * sizeof(arlequin::Vec3)));
   std::printf("threads %d: DEs %.0f, bonds %.0f, setup %.3f s, %ld steps %.3f s (%.3f ms/step), "
-              "particle-steps/s %.3e, bond-steps/s %.3e\n",
-              threads, n, bonds, setup, o.steps, run, 1e3 * run / o.steps, n * o.steps / run, bonds * o.steps / run);
+              "particle-steps/s %.3e, bond-steps/s %.3e, fingerprint %016llx\n",
+              threads, n, bonds, setup, o.steps, run, 1e3 * run / o.steps, n * o.steps / run, bonds * o.steps / run,
+              static_cast<unsigned long long>(print));
   if (first)
     std::printf("  memory: scene %.1f MB resident = %.0f B per DE + bond pair (%.0f B/DE if all charged to DEs, "
                 "%.0f B/bond if all to bonds); peak RSS %.1f MB\n",
@@ -120,14 +138,18 @@ Timing run_virtual_test(const Options& o, int threads, arlequin::StepProfile& pr
   const auto out = std::filesystem::temp_directory_path() / "bench_bonded_block_virtual_test";
   std::filesystem::remove_all(out);
   arlequin::app::SceneOptions options;
+  options.overrides = o.overrides;
   options.profile = &profile;
   const double before = profile.seconds();
   const long steps_before = profile.steps();
   arlequin::app::run_virtual_test_suite(o.spec, options, out, {o.sample}, {o.test});
   const double run = profile.seconds() - before;
   const long steps = profile.steps() - steps_before;
-  std::printf("threads %d: %s %s, %ld steps %.3f s (%.3f ms/step)\n", threads, o.sample.c_str(), o.test.c_str(), steps,
-              run, 1e3 * run / double(std::max(steps, 1L)));
+  std::ifstream series_file(out / o.sample / o.test / "series.csv", std::ios::binary);
+  const std::string series((std::istreambuf_iterator<char>(series_file)), std::istreambuf_iterator<char>());
+  std::printf("threads %d: %s %s, %ld steps %.3f s (%.3f ms/step), fingerprint of series.csv %016llx\n", threads,
+              o.sample.c_str(), o.test.c_str(), steps, run, 1e3 * run / double(std::max(steps, 1L)),
+              static_cast<unsigned long long>(fingerprint(series.data(), series.size())));
   return {run, double(steps)};
 }
 
