@@ -49,7 +49,7 @@ std::string StepProfile::comparison(const StepProfile& one, const StepProfile& m
   const double total_many = many.seconds();
   for (const Phase& p : one.phases_) {
     const auto it = std::find_if(many.phases_.begin(), many.phases_.end(), [&](const Phase& q) { return q.name == p.name; });
-    if (it == many.phases_.end()) continue;
+    if (it == many.phases_.end() || !(p.seconds > 0.0 && it->seconds > 0.0)) continue;  // not run (a phase of the runner)
     const double s = p.seconds / it->seconds;
     out += line("%-*s %11.4f %11.4f %7.2fx %7.1f%% %8.1f%%\n", w, p.name.c_str(), p.seconds * per_step,
                 it->seconds * per_step, s, 100.0 * serial_fraction(s, threads), 100.0 * it->serial_seconds / total_many);
