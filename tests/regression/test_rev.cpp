@@ -3,6 +3,7 @@
 // (app/virtual_tests.hpp, app/calibrate.hpp, cases/rev_elastic; docs/validation.md R2, R3).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -13,6 +14,7 @@
 #include "common/error.hpp"
 #include "common/json.hpp"
 #include "support/cli.hpp"
+#include "support/omp_threads.hpp"
 
 namespace arlequin {
 namespace {
@@ -304,6 +306,32 @@ TEST(RevFailure, ReducedRevBreaksNearTheFibreStrain) {
 
 // The end rule of a test to failure: a brittle break rings through zero; with stop_after the
 // run goes on until the stress stays low, without it the first low row ends it.
+// The REV's failure test (the reduced REV of the test above) on one and two threads: its bond
+// passes gather on threads, its per-DE loops (kicks, damping, the finite check) run on threads
+// split alike; BBF, and RDEF whose virial the gather records. The series and breaks are the same
+// byte for byte, and --test runs only the named test.
+TEST(RevFailure, RunsAreBitIdenticalOnOneAndTwoThreads) {
+  const auto dir = test::scratch_dir("rev_failure_threads");
+  const auto spec = std::filesystem::path(ARLEQUIN_SOURCE_DIR) / "cases" / "rev_failure" / "failure_tests.yaml";
+  std::map<std::string, std::string> files[2];
+  for (int threads : {1, 2}) {
+    const test::OmpThreadsOfRuns scope(threads);
+    const auto out = dir / ("threads_" + std::to_string(threads));
+    const auto r = test::run_arlequin("virtual-test " + spec.string() + " --sample rev_10k --test L_bbf --test L_rdef" +
+                                      " --set dem.sample.radius.mean=7.5e-5 --set dem.sample.file=" + (dir / "sample.h5").string() +
+                                      " --out " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(test::read_csv(out / "failure.csv").size(), 2u);
+    for (const char* name : {"L_bbf", "L_rdef"})
+      for (const char* file : {"series.csv", "breaks.csv"})
+        files[threads - 1][std::string(name) + "/" + file] = test::read_text(out / "rev_10k" / name / file);
+  }
+  for (const auto& [name, text] : files[0]) {
+    EXPECT_GT(std::count(text.begin(), text.end(), '\n'), 50) << name;  // rows; breaks: both break
+    EXPECT_EQ(text, files[1][name]) << name;
+  }
+}
+
 TEST(RevFailure, EndRuleWaitsOutTheRingingOfABreakWhenAsked) {
   app::FailurePlan plan;
   plan.expected_strain = 1e-2;

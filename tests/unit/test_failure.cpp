@@ -341,6 +341,22 @@ TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   };
   const Pass one = pass(1), two = pass(2);
   EXPECT_TRUE(beam.runs_on_threads());
+  // The beams gather per DE (BeamBondSet::accumulate_forces): their sums are those of a scatter
+  // of each bond's actions, evaluated alone, in bond order from zero, the same additions in the
+  // same order at every DE.
+  std::vector<Vec3> force(p.size()), torque(p.size());
+  for (std::size_t b = 0; b < beam.size(); ++b) {
+    const BeamBondSet::Actions actions = beam.actions(b, p);
+    const std::uint32_t i = beam.first()[b], j = beam.second()[b];
+    force[i] -= actions.force_on_j;
+    force[j] += actions.force_on_j;
+    torque[i] += actions.torque_on_i;
+    torque[j] += actions.torque_on_j;
+  }
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_EQ(force[i], one.force[i]) << i;
+    ASSERT_EQ(torque[i], one.torque[i]) << i;
+  }
   for (std::size_t i = 0; i < p.size(); ++i) {
     ASSERT_EQ(one.force[i], two.force[i]) << i;
     ASSERT_EQ(one.torque[i], two.torque[i]) << i;
