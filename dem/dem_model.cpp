@@ -82,9 +82,9 @@ void DemModel::finalize() {
         }
         owner[i][k] = static_cast<int>(c);
       }
-      if (bc.kinematic()) constraints_.push_back({i, static_cast<std::uint32_t>(c)});
+      if (bc.kinematic()) constraints_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i)});
       if (bc.kind == BoundaryKind::force) {
-        loaded_.push_back({i, static_cast<std::uint32_t>(c)});
+        loaded_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i)});
         load_per_particle_.push_back(bc.value / static_cast<double>(ids.size()));
       }
     }
@@ -160,8 +160,7 @@ void DemModel::set_profile(StepProfile* profile) {
   profile_ = profile;
   if (!profile) return;
   phase_.kick = profile->phase("kicks");
-  phase_.drift = profile->phase("drift");
-  phase_.clear = profile->phase("clear forces");
+  phase_.drift = profile->phase("drift and clear forces");
   phase_.boundary = profile->phase("boundary conditions");
   if (neighbours_) phase_.neighbours = profile->phase("neighbour list");
   phase_.bonds.clear();
@@ -201,7 +200,7 @@ void DemModel::advance_to_forces(double dt) {
   }
   {
     const PhaseTimer timer(profile_, phase_.drift, particles_threaded);
-    drift(dt);                        // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n)
+    drift(dt);                        // x(n+1) = x(n) + dt v(n+1/2); q(n+1) = exp(dt w) q(n); f = 0
   }
   time_ += dt;
   {
@@ -213,7 +212,7 @@ void DemModel::advance_to_forces(double dt) {
   ForceScan scan = failure_on_ ? failure_scan() : ForceScan{};
   scan.energy = std::exchange(energy_record_requested_, false);
   // Friction's power at the half-step velocities, over the step (as the damping's work).
-  dissipated_ += dt * compute_forces(scan);
+  dissipated_ += dt * compute_forces(scan, true);
   if (failure_on_) apply_failures(scan.energy);  // BBF / RDEF: break bonds, forces again if any broke
   energy_record_step_ = scan.energy ? steps_ + 1 : -1;
   record_reactions();                 // for sensors, and the work of driven DEs
@@ -289,7 +288,7 @@ double DemModel::driven_kinetic_energy() const {
     const BoundaryCondition& bc = boundaries_[c.condition];
     const Vec3& v = particles.velocity[c.particle];
     for (int k = 0; k < 3; ++k)
-      if (bc.components[k]) e += 0.5 * particles.mass(c.particle) * v[k] * v[k];
+      if (bc.components[k]) e += 0.5 * c.mass * v[k] * v[k];
   }
   return e;
 }
@@ -302,6 +301,7 @@ void DemModel::drift(double dt) {
     // Spheres: omega is constant over the drift, so the rotation is exact.
     if (norm2(p.angular_velocity[i]) > 0.0)
       p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
+    p.force[i] = p.torque[i] = Vec3{};  // for the force pass: one pass over the DEs, not two
   });
 }
 
@@ -309,11 +309,8 @@ void DemModel::update_neighbours() {
   if (neighbours_ && neighbours_->needs_rebuild(particles)) neighbours_->build(particles);
 }
 
-double DemModel::compute_forces(const ForceScan& scan) {
-  {
-    const PhaseTimer timer(profile_, phase_.clear, runs_threaded(static_cast<long>(particles.size()) > parallel_threshold));
-    particles.clear_forces();
-  }
+double DemModel::compute_forces(const ForceScan& scan, bool cleared) {
+  if (!cleared) particles.clear_forces();
   for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
     const PhaseTimer timer(profile_, profile_ ? phase_.bonds[s] : 0, runs_threaded(bond_sets_[s]->runs_on_threads()));
     bond_sets_[s]->accumulate_forces(particles, scan);

@@ -141,7 +141,9 @@ class DemModel {
   void impose_motion(double t, bool half_step, double dt);
   void drift(double dt);
   void update_neighbours();
-  double compute_forces(const ForceScan& scan = {});  // returns the friction's power, W
+  // Forces of the current configuration (cleared first unless `cleared`: the drift does it);
+  // returns the friction's power, W.
+  double compute_forces(const ForceScan& scan = {}, bool cleared = false);
   // check_finite's contact part, given what its pass over the DEs found.
   struct ContactResolution {
     double reach = 0.0;           // the largest distance a DE moved in the last step, over its radius
@@ -168,6 +170,7 @@ class DemModel {
   struct Constraint {
     std::uint32_t particle;
     std::uint32_t condition;  // index into boundaries_
+    double mass;              // the DE's (weighted) mass, kg, for the driven kinetic energy
   };
   std::vector<std::string> group_names_;
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
@@ -201,7 +204,7 @@ class DemModel {
   // The step's phases in profile_ (set_profile), one per bond set in bonds.
   StepProfile* profile_ = nullptr;
   struct ProfilePhases {
-    int kick, drift, clear, boundary, neighbours, contacts, failure, reactions, loads, finite;
+    int kick, drift, boundary, neighbours, contacts, failure, reactions, loads, finite;
     std::vector<int> bonds;
   } phase_{};
   std::vector<std::uint8_t> driven_;  // per DE: bits 0-2 imposed x, y, z; bit 3 rotation locked

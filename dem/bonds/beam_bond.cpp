@@ -180,7 +180,11 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
   return a[0];
 }
 
-void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const {
+// Never inlined: one compiled copy serves the gather (which the OpenMP region and the calling
+// thread each compile) and single bonds, so FMA contraction cannot differ between them (the bits
+// of a bond's actions do not depend on who asks).
+[[gnu::noinline]] void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p,
+                                            ActionsBlock& out) const {
   assert(count >= 1 && count <= lanes);
   // Lane l holds bond first + l; lanes past count repeat the last bond (out holds it there
   // again). The DEs' positions are gathered lane by lane, their orientations loaded whole and
