@@ -277,29 +277,39 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
         }
     }
     // Every bonded DE adds its bonds' actions in bond order (-f on a first DE, +f on a second),
-    // split over the threads in DE order as the kicks; and, recording the virial, its intact
-    // bonds' terms.
-    const auto& [fx, fy, fz, tix, tiy, tiz, tjx, tjy, tjz] = bond_actions_;
-#pragma omp for schedule(static)
+    // split over the threads in DE order as the kicks. Raw pointers: nothing in the loop can
+    // move the arrays, and the compiler keeps them in registers.
+    const double *fx = bond_actions_[0].data(), *fy = bond_actions_[1].data(), *fz = bond_actions_[2].data();
+    const double *tix = bond_actions_[3].data(), *tiy = bond_actions_[4].data(), *tiz = bond_actions_[5].data();
+    const double *tjx = bond_actions_[6].data(), *tjy = bond_actions_[7].data(), *tjz = bond_actions_[8].data();
+    const std::uint32_t *bonded = bonded_.data(), *offsets = end_offsets_.data(), *ends = end_bonds_.data();
+    Vec3 *force = p.force.data(), *torque = p.torque.data();
+#pragma omp for schedule(static) nowait
     for (long k = 0; k < n; ++k) {
-      const std::uint32_t i = bonded_[k];
-      Vec3 force{}, torque{};
-      for (std::uint32_t e = end_offsets_[k]; e < end_offsets_[k + 1]; ++e) {
-        const std::uint32_t b = end_bonds_[e] >> 1;
-        const int end = static_cast<int>(end_bonds_[e] & 1u);
-        const Vec3 force_on_j{fx[b], fy[b], fz[b]};
-        if (end == 1) {
-          force += force_on_j;
-          torque += Vec3{tjx[b], tjy[b], tjz[b]};
+      Vec3 f{}, t{};
+      for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
+        const std::uint32_t b = ends[e] >> 1;
+        if (ends[e] & 1u) {
+          f += Vec3{fx[b], fy[b], fz[b]};
+          t += Vec3{tjx[b], tjy[b], tjz[b]};
         } else {
-          force -= force_on_j;
-          torque += Vec3{tix[b], tiy[b], tiz[b]};
+          f -= Vec3{fx[b], fy[b], fz[b]};
+          t += Vec3{tix[b], tiy[b], tiz[b]};
         }
-        if (r.virial && !broken_[b]) add_bond_end_virial(p, first_[b], second_[b], -force_on_j, scan.branch, end, scan.virial[i]);
       }
-      p.force[i] += force;
-      p.torque[i] += torque;
+      force[bonded[k]] += f;
+      torque[bonded[k]] += t;
     }
+    if (!r.virial) return;
+    // Recording the virial (RDEF): each DE's intact bonds' terms, in bond order, as accumulate_virial.
+#pragma omp for schedule(static)
+    for (long k = 0; k < n; ++k)
+      for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
+        const std::uint32_t b = ends[e] >> 1;
+        if (!broken_[b])
+          add_bond_end_virial(p, first_[b], second_[b], -Vec3{fx[b], fy[b], fz[b]}, scan.branch, static_cast<int>(ends[e] & 1u),
+                              scan.virial[bonded[k]]);
+      }
   });
 }
 
