@@ -169,12 +169,17 @@ int main(int argc, char** argv) try {
   else
     std::printf("bonded block benchmark: %s, %ld steps, no output\n", o.case_file.c_str(), o.steps);
   // Bytes the structure-of-arrays layout stores per DE and per beam bond (fields of
-  // ParticleSet; BeamBondSet: two indices, L0, three stiffnesses, two unit vectors).
+  // ParticleSet; BeamBondSet: two indices, L0, beam radius, three stiffnesses, two unit vectors,
+  // the broken flag, the energy and failure-measure records; and the gather's scratch: nine
+  // action components and two bond ends).
   using arlequin::Quat;
   using arlequin::Vec3;
   constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 2 * sizeof(double) + sizeof(arlequin::dem::GroupMask);
-  constexpr std::size_t per_bond = 2 * sizeof(std::uint32_t) + 4 * sizeof(double) + 2 * sizeof(Vec3);
-  if (!virtual_test) std::printf("layout: %zu B per DE, %zu B per beam bond (targets <= 200, <= 150)\n", per_de, per_bond);
+  constexpr std::size_t per_bond = 2 * sizeof(std::uint32_t) + 5 * sizeof(double) + 2 * sizeof(Vec3) + 1 + 2 * sizeof(double);
+  constexpr std::size_t per_bond_gather = 9 * sizeof(double) + 2 * sizeof(std::uint32_t);
+  if (!virtual_test)
+    std::printf("layout: %zu B per DE, %zu B per beam bond + %zu B of gather scratch (targets <= 200, <= 150)\n", per_de,
+                per_bond, per_bond_gather);
   std::map<int, std::vector<double>> rates;  // work per second of each run, by thread count
   std::map<int, arlequin::StepProfile> profiles;
   for (int r = 0; r < o.repeat; ++r)
