@@ -774,6 +774,29 @@ TEST(Cases, PulseDisplacementIsTheIntegralOfItsVelocity) {
   }
 }
 
+// `run --profile` prints the step's phases after the run: the DEM's, one per bond set, and the
+// runner's, each with its share, and the step's row; on one thread all of it runs serially.
+TEST(Cases, ProfilePrintsThePhasesOfTheStep) {
+  const test::OmpThreadsOfRuns scope(1);
+  const auto out = test::scratch_dir("profile_block");
+  const auto r = test::run_arlequin("run " + cases + "bonded_block_tension/case.yaml --steps 20 --profile --quiet --out " +
+                                        out.string(),
+                                    "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto at = r.output.find("profile of the step, 1 thread(s):");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::string table = r.output.substr(at);
+  for (const char* phase : {"kicks", "drift and clear forces", "bonds bonds (beam, gather)", "group reactions", "finite check",
+                            "sensors, energies, output"})
+    EXPECT_NE(table.find(std::string("\n") + phase + " "), std::string::npos) << phase << "\n" << table;
+  std::istringstream step_row(table.substr(table.find("\nstep ") + 1));
+  std::string name, ms, share, serial;
+  step_row >> name >> ms >> share >> serial;
+  EXPECT_GT(std::stod(ms), 0.0) << table;
+  EXPECT_EQ(share, "100.0%") << table;
+  EXPECT_EQ(serial, "100.0%") << table;
+}
+
 // Results independent of the thread count, to the bit, for whole runs (not only the bond pass):
 // a breaking lattice bar, the bonded block of the benchmark (20 000 DEs: its kicks and drift on
 // threads too) and a coupled bar, each large enough that its bond pass runs on threads (above

@@ -385,6 +385,9 @@ TEST(VirtualTests, NamesAreUniqueAndSamplesAreSuggested) {
   r = test::run_arlequin(run + " --sample dens");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--sample dens: no sample of that name; did you mean 'dense'?"), std::string::npos) << r.output;
+  r = test::run_arlequin(run + " --test l");  // --test: the same for a test's name
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--test l: no test of that name; did you mean 'L'?"), std::string::npos) << r.output;
   // A spec's own override names its line and key, not a --set the user never typed.
   write(dir / "spec.yaml", "case: sample.yaml\nsamples: [{name: a, set: [dem.dampng=1]}]\ntests: [{name: L, tension: z}]\n");
   r = test::run_arlequin(run);
