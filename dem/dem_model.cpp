@@ -82,9 +82,12 @@ void DemModel::finalize() {
         }
         owner[i][k] = static_cast<int>(c);
       }
-      if (bc.kinematic()) constraints_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i)});
+      if (bc.kinematic())
+        constraints_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i),
+                                static_cast<std::uint8_t>(bc.components[0] | bc.components[1] << 1 | bc.components[2] << 2 |
+                                                          bc.lock_rotation << 3)});
       if (bc.kind == BoundaryKind::force) {
-        loaded_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i)});
+        loaded_.push_back({i, static_cast<std::uint32_t>(c), particles.mass(i), 0});
         load_per_particle_.push_back(bc.value / static_cast<double>(ids.size()));
       }
     }
@@ -96,11 +99,7 @@ void DemModel::finalize() {
     for (GroupMask m = particles.groups[i] & watched_; m; m &= m - 1)
       watched_members_.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(std::countr_zero(m))});
   driven_.assign(particles.size(), 0);
-  for (const Constraint& c : constraints_) {
-    const BoundaryCondition& bc = boundaries_[c.condition];
-    for (int k = 0; k < 3; ++k) driven_[c.particle] |= bc.components[k] << k;
-    driven_[c.particle] |= bc.lock_rotation << 3;
-  }
+  for (const Constraint& c : constraints_) driven_[c.particle] |= c.imposed;
   if (damping_ > 0.0) {
     damping_force_.assign(particles.size(), Vec3{});
     damping_torque_.assign(particles.size(), Vec3{});
@@ -274,21 +273,19 @@ void DemModel::impose_motion(double t, bool half_step, double dt) {
       condition_velocity_[k] = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
   }
   for (const Constraint& c : constraints_) {
-    const BoundaryCondition& bc = boundaries_[c.condition];
     const Vec3& v = condition_velocity_[c.condition];
     for (int k = 0; k < 3; ++k)
-      if (bc.components[k]) particles.velocity[c.particle][k] = v[k];
-    if (bc.lock_rotation) particles.angular_velocity[c.particle] = {};
+      if (c.imposed >> k & 1) particles.velocity[c.particle][k] = v[k];
+    if (c.imposed & 8) particles.angular_velocity[c.particle] = {};
   }
 }
 
 double DemModel::driven_kinetic_energy() const {
   double e = 0.0;
   for (const Constraint& c : constraints_) {
-    const BoundaryCondition& bc = boundaries_[c.condition];
     const Vec3& v = particles.velocity[c.particle];
     for (int k = 0; k < 3; ++k)
-      if (bc.components[k]) e += 0.5 * c.mass * v[k] * v[k];
+      if (c.imposed >> k & 1) e += 0.5 * c.mass * v[k] * v[k];
   }
   return e;
 }
@@ -402,10 +399,9 @@ void DemModel::record_reactions() {
   // Only the imposed components: forces along free ones move the DE like any other.
   for (std::size_t k = 0; k < constraints_.size(); ++k) {
     const std::uint32_t i = constraints_[k].particle;
-    const BoundaryCondition& bc = boundaries_[constraints_[k].condition];
     Vec3 reaction{};
     for (int d = 0; d < 3; ++d)
-      if (bc.components[d]) reaction[d] = -p.force[i][d];
+      if (constraints_[k].imposed >> d & 1) reaction[d] = -p.force[i][d];
     external_work_ += dot(0.5 * (reaction + constraint_reaction_[k]), p.velocity[i]) * last_dt_;
     constraint_reaction_[k] = reaction;
   }

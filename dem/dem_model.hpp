@@ -171,6 +171,7 @@ class DemModel {
     std::uint32_t particle;
     std::uint32_t condition;  // index into boundaries_
     double mass;              // the DE's (weighted) mass, kg, for the driven kinetic energy
+    std::uint8_t imposed;     // bits 0-2: the condition imposes x, y, z; bit 3: it locks rotation
   };
   std::vector<std::string> group_names_;
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
