@@ -617,29 +617,32 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       ++steps_done;
       if (profile) profile->count_step();
       model.check_finite();  // the DEM times it
-      std::optional<PhaseTimer> timer(std::in_place, profile, phase.checks, false);
-      if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
-      if (const auto damage = scene.model->damage_in_overlap()) {
-        const bool first = result.damage_in_overlap.empty();
-        if (first) result.damage_in_overlap = "step " + std::to_string(n) + ": " + damage->description;
-        result.damage_in_overlap_breaks += damage->breaks;
-        if (damage->stop)
-          throw RunError(result.damage_in_overlap + "; the run stops (coupling.on_damage_in_overlap: stop; warn goes on)");
-        if (first)
-          std::fprintf(stderr, "  warning: %s; the run goes on (coupling.on_damage_in_overlap: warn)\n", result.damage_in_overlap.c_str());
+      {
+        const PhaseTimer timer(profile, phase.checks, false);
+        if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
+        if (const auto damage = scene.model->damage_in_overlap()) {
+          const bool first = result.damage_in_overlap.empty();
+          if (first) result.damage_in_overlap = "step " + std::to_string(n) + ": " + damage->description;
+          result.damage_in_overlap_breaks += damage->breaks;
+          if (damage->stop)
+            throw RunError(result.damage_in_overlap + "; the run stops (coupling.on_damage_in_overlap: stop; warn goes on)");
+          if (first)
+            std::fprintf(stderr, "  warning: %s; the run goes on (coupling.on_damage_in_overlap: warn)\n", result.damage_in_overlap.c_str());
+        }
+        if (n % 50 == 0 || n == total_steps)
+          model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
+                                      std::abs(model.external_work() + continuum_work(scene))) +
+                             1e-300);
       }
-      if (n % 50 == 0 || n == total_steps)
-        model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
-                                    std::abs(model.external_work() + continuum_work(scene))) +
-                           1e-300);
-      timer.emplace(profile, phase.outputs, false);
-      if (output_after(n)) write_outputs();
-      if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {
-        save_checkpoint();
-        while (next_checkpoint <= current_time() + slack) next_checkpoint += checkpoint_every;
+      {
+        const PhaseTimer timer(profile, phase.outputs, false);
+        if (output_after(n)) write_outputs();
+        if (checkpoint_every > 0.0 && current_time() + slack >= next_checkpoint && n < total_steps) {
+          save_checkpoint();
+          while (next_checkpoint <= current_time() + slack) next_checkpoint += checkpoint_every;
+        }
+        progress.update(n, current_time());
       }
-      progress.update(n, current_time());
-      timer.reset();
       if (!result.stop_reason.empty()) break;
     }
   } catch (const RunError& e) {

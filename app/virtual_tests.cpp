@@ -1072,29 +1072,25 @@ int run_virtual_test_suite(const std::filesystem::path& spec_file, const SceneOp
   const auto& failure = spec.failure;
   const auto& composite = spec.composite;
   const auto& roles = spec.roles;
-  std::vector<std::string_view> sample_names;
-  std::string listed;
-  for (const SampleVariant& s : samples) {
-    sample_names.push_back(s.name);
-    listed += (listed.empty() ? "" : ", ") + s.name;
-  }
-  for (const auto& name : only_samples)
-    if (std::find(sample_names.begin(), sample_names.end(), name) == sample_names.end()) {
-      const auto guess = closest_match(name, sample_names);
-      throw InputError(spec_file.string() + ": --sample " + name + ": no sample of that name" +
-                       (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; samples: " + listed));
+  // --sample and --test name what the spec has: an unknown name gets the closest, or the list.
+  const auto require_known = [&](const std::vector<std::string>& asked, const auto& items, const std::string& what) {
+    std::vector<std::string_view> names;
+    std::string listed;
+    for (const auto& item : items) {
+      names.push_back(item.name);
+      listed += (listed.empty() ? "" : ", ") + item.name;
     }
-  if (!only_tests.empty()) {
-    std::vector<std::string_view> test_names;
-    for (const LoadCase& t : tests) test_names.push_back(t.name);
-    for (const auto& name : only_tests)
-      if (std::find(test_names.begin(), test_names.end(), name) == test_names.end()) {
-        const auto guess = closest_match(name, test_names);
-        throw InputError(spec_file.string() + ": --test " + name + ": no test of that name" +
-                         (guess ? "; did you mean '" + std::string(*guess) + "'?" : ""));
+    for (const auto& name : asked)
+      if (std::find(names.begin(), names.end(), name) == names.end()) {
+        const auto guess = closest_match(name, names);
+        throw InputError(spec_file.string() + ": --" + what + " " + name + ": no " + what + " of that name" +
+                         (guess ? "; did you mean '" + std::string(*guess) + "'?" : "; " + what + "s: " + listed));
       }
+  };
+  require_known(only_samples, samples, "sample");
+  require_known(only_tests, tests, "test");
+  if (!only_tests.empty())
     std::erase_if(tests, [&](const LoadCase& t) { return std::find(only_tests.begin(), only_tests.end(), t.name) == only_tests.end(); });
-  }
   check_every_test(case_file, options, samples, only_samples, tests, failure.has_value(), references);
   if (failure) return run_failure_suite(case_file, options, out_dir, samples, only_samples, tests, references, *failure);
 

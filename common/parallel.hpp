@@ -27,14 +27,6 @@ inline constexpr long parallel_threshold_bonds = 256;
 // second (bench_coupled_step, bench_bonded_block).
 inline constexpr long parallel_threshold_bond_particles = 2048;
 
-// Runs loop() on the OpenMP threads if `threaded` and there is more than one, else in the
-// calling thread; loop() holds orphaned `omp for` loops, which split over the team inside the
-// region and run whole outside it. Not entering OpenMP at all is the point: a parallel region
-// whose `if` clause is false still starts a team of one, which costs about a hundred times an
-// orphaned loop outside any region (bench_omp_regions prints both); a small coupled step enters
-// several such regions, and paid for them a third of its time. Not for
-// use inside a parallel region: an orphaned loop there would split over the enclosing team, or
-// hang if only some of its threads reach it (none of ours nests).
 // The threads an OpenMP loop may use (1 without OpenMP).
 inline int max_threads() {
 #ifdef _OPENMP
@@ -49,6 +41,14 @@ inline bool runs_threaded(bool threaded) {
   return threaded && max_threads() > 1;
 }
 
+// Runs loop() on the OpenMP threads if `threaded` and there is more than one, else in the
+// calling thread; loop() holds orphaned `omp for` loops, which split over the team inside the
+// region and run whole outside it. Not entering OpenMP at all is the point: a parallel region
+// whose `if` clause is false still starts a team of one, which costs about a hundred times an
+// orphaned loop outside any region (bench_omp_regions prints both); a small coupled step enters
+// several such regions, and paid for them a third of its time. Not for
+// use inside a parallel region: an orphaned loop there would split over the enclosing team, or
+// hang if only some of its threads reach it (none of ours nests).
 template <class Loop>
 void run_threaded_if(bool threaded, Loop&& loop) {
 #ifdef _OPENMP

@@ -181,8 +181,7 @@ void DemModel::step(double dt) {
 
 void DemModel::advance_to_forces(double dt) {
   last_dt_ = dt;
-  const long n = static_cast<long>(particles.size());
-  const bool particles_threaded = runs_threaded(n > parallel_threshold);
+  const bool particles_threaded = particle_loops_threaded();
   {
     // Work of kinematic conditions = the driven DEs' kinetic energy change (here and at the
     // end of the step) + the work of their reactions (record_reactions).
@@ -223,7 +222,7 @@ void DemModel::advance_to_forces(double dt) {
 
 void DemModel::finish_step(double dt) {
   {
-    const PhaseTimer timer(profile_, phase_.kick, runs_threaded(static_cast<long>(particles.size()) > parallel_threshold));
+    const PhaseTimer timer(profile_, phase_.kick, particle_loops_threaded());
     kick(0.5 * dt);                   // v(n+1) = v(n+1/2) + dt/2 a(n+1)
   }
   const PhaseTimer timer(profile_, phase_.boundary, false);
@@ -511,7 +510,7 @@ Vec3 DemModel::mean_velocity(int group) const {
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-  const PhaseTimer timer(profile_, phase_.finite, !contact_ && runs_threaded(n > parallel_threshold));
+  const PhaseTimer timer(profile_, phase_.finite, !contact_ && particle_loops_threaded());
   // Without contact only non-finite velocities count: a count on the threads, split as the
   // kicks, and the serial pass below only to name the first of them.
   if (!contact_ && fixed_order_sum(n, parallel_threshold, check_partial_, [&p](long i) {

@@ -159,6 +159,8 @@ class DemModel {
   void record_reactions();
   void apply_failures(bool record_energy);  // record_energy: the forces' recomputation records too
   bool break_failed_bonds();                // apply_failures' breaks; false: none failed
+  // Whether the loops over every DE (kicks, drift, damping, the finite check) run on threads.
+  bool particle_loops_threaded() const { return runs_threaded(static_cast<long>(particles.size()) > parallel_threshold); }
   // Makes the bond sets' energy records those of the current configuration (a pass over the
   // bonds unless the last step's force pass recorded them).
   void use_energy_record() const;
