@@ -239,6 +239,16 @@ void print_scene_facts(const app::Scene& scene) {
                 scene.sample_file.string().c_str(), r.compaction, r.mean_coordination, r.interior_coordination,
                 r.fabric_eigenvalues[0], r.fabric_eigenvalues[1], r.fabric_eigenvalues[2], r.max_overlap, r.seconds);
   }
+  if (scene.weave) {
+    const auto& w = *scene.weave;
+    std::printf("  weave: %d weft, %d stuffer, %d binder yarns (lengths %.4g, %.4g, %.4g mm); binder amplitude %.4g mm, crimp %.4f;"
+                " DE radius %.4g mm, spring K %.4g N/m\n"
+                "    areal density %.4f kg/m^2, thickness %.4g mm, fibre volume fraction %.3f, yarn mass %.4g g,"
+                " deepest overlap of unjoined DEs %.2g of 2R\n",
+                w.wefts, w.stuffers, w.binders, w.weft_length * 1e3, w.stuffer_length * 1e3, w.binder_length * 1e3, w.amplitude * 1e3,
+                w.crimp, w.radius * 1e3, w.spring_stiffness, w.areal_density, w.thickness * 1e3, w.fibre_volume_fraction, w.mass * 1e3,
+                w.deepest_overlap);
+  }
   for (const auto& set : model.bond_sets()) {
     std::printf("  %s (%s): %zu\n", set->name == "bonds" ? "bonds" : (set->name + " bonds").c_str(), std::string(set->law()).c_str(),
                 set->size());

@@ -20,23 +20,26 @@
 #include "dem/contacts/contact_law.hpp"
 #include "dem/sample_file.hpp"
 #include "dem/samples.hpp"
+#include "dem/weave.hpp"
 
 namespace arlequin::app {
 namespace {
 
 constexpr KeyDoc dem_keys[] = {
     {"sample", KeyType::section, "", {}, "", "how the DEs are placed (lattice, chain, particles, packing)"},
-    {"density", KeyType::number, "kg/m^3", Range::positive(), "(none)", "DE density, with one bond law for all (else materials)"},
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "(none)",
+     "DE density, with one bond law for all (else materials); with a weave, of the listed DEs that give none"},
     {"bond", KeyType::section, "", {}, "(none)", "bonds between every two DEs that touch, one law for all"},
     {"materials", KeyType::names, "", {}, "(none)", "materials by name, each with its density, region and bond law"},
     {"interface", KeyType::section, "", {}, "(none)", "the bond law between DEs of two different materials"},
     {"bond_tolerance", KeyType::number, "1", Range::between(0, 1), "(the packing's, else 0.01)", "gap, over the mean radius, below which two DEs of materials bond"},
     {"contact", KeyType::section, "", {}, "(none)", "contact between DEs that are not bonded (a neighbour search)"},
     {"damping", KeyType::number, "1/s", Range::non_negative(), "0", "viscous damping of DE velocities, c in dv/dt = ... - c v"},
+    {"gravity", KeyType::vec3, "m/s^2", {}, "[0, 0, 0]", "uniform gravity: a body force m g on every DE (its work in W_external)"},
     {"failure", KeyType::section, "", {}, "(none)", "failure criteria beyond the bond laws' own (RDEF)"},
 };
 constexpr KeyDoc sample_keys[] = {
-    {"build", KeyType::choice, "", {}, "", "how the DEs are made", "lattice | chain | particles | packing"},
+    {"build", KeyType::choice, "", {}, "", "how the DEs are made", "lattice | chain | particles | packing | weave"},
     {"radius", KeyType::number, "m", Range::positive(), "(none)", "DE radius (lattice, chain); a packing gives a distribution instead"},
     {"spacing", KeyType::number, "m", Range::positive(), "(2 radius)", "centre distance of neighbours (lattice, chain)"},
     {"origin", KeyType::vec3, "m", {}, "[0, 0, 0]", "centre of the lattice's first DE"},
@@ -53,6 +56,22 @@ constexpr KeyDoc sample_keys[] = {
     {"seed", KeyType::integer, "", Range::non_negative(), "1", "random seed of the packing"},
     {"bond_tolerance", KeyType::number, "1", Range::between(0, 0.5), "0.03", "gap, over the mean radius, that counts as contact in the packing"},
     {"file", KeyType::string, "", {}, "(results/<name>/sample.h5)", "where the packing is cached (HDF5), relative to the case"},
+    {"size", KeyType::numbers, "m", Range::positive(), "", "weave: the fabric's extent [along x (weft), along y (warp)]"},
+    {"weft_layers", KeyType::integer, "", Range::at_least(2), "3", "weave: layers of weft yarns"},
+    {"weft_spacing", KeyType::number, "m", Range::positive(), "", "weave: centre distance of the weft columns (along y)"},
+    {"warp_spacing", KeyType::number, "m", Range::positive(), "", "weave: centre distance of the stuffer warps (along x); a binder runs midway"},
+    {"yarn_width", KeyType::number, "m", Range::positive(), "", "weave: width of a yarn's cross-section"},
+    {"yarn_thickness", KeyType::number, "m", Range::positive(), "", "weave: thickness of a yarn's cross-section (2 R chains_through)"},
+    {"chains", KeyType::numbers, "1", Range::at_least(1), "[1, 1]", "weave: parallel DE chains of a yarn [across its width, through its thickness] (n_p their product)"},
+    {"crimp", KeyType::number, "1", Range::positive(), "(the smallest that clears the weft)", "weave: the binders' crimp, path length over fabric length - 1"},
+    {"clamp_width", KeyType::number, "m", Range::non_negative(), "0", "weave: width of the border whose DEs form the group 'edges'"},
+    {"yarn", KeyType::section, "", {}, "", "weave: the yarn's material and spring law (seed Eqs. 6-8)"},
+};
+constexpr KeyDoc yarn_keys[] = {
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "", "yarn density over its section S (a DE's mass: rho S L_y / DEs of the yarn)"},
+    {"modulus", KeyType::number, "Pa", Range::positive(), "", "yarn modulus E: a spring of rest length L0 has K = E S / (n_p L0)"},
+    {"section", KeyType::number, "m^2", Range::positive(), "(pi yarn_width yarn_thickness / 4)", "the yarn's section S"},
+    {"failure_strain", KeyType::number, "1", Range::non_negative(), "0", "elongation at which a spring breaks; 0: never"},
 };
 constexpr KeyDoc radius_distribution_keys[] = {
     {"mean", KeyType::number, "m", Range::positive(), "", "mean DE radius"},
@@ -63,6 +82,7 @@ constexpr KeyDoc particle_keys[] = {
     {"position", KeyType::vec3, "m", {}, "", "centre of the DE"},
     {"radius", KeyType::number, "m", Range::positive(), "", "radius of the DE"},
     {"velocity", KeyType::vec3, "m/s", {}, "[0, 0, 0]", "initial velocity"},
+    {"density", KeyType::number, "kg/m^3", Range::positive(), "(dem.density)", "density of this DE (an impactor of another material)"},
 };
 constexpr KeyDoc bond_law_key{"law", KeyType::choice, "", {}, "", "the bond law (arlequin laws); its own keys follow in 'bond (law: ...)'",
                               "beam | spring | cohesive_bilinear"};
@@ -105,6 +125,7 @@ constexpr SchemaSection dem_sections[] = {
     {"dem", "the discrete elements", dem_keys},
     {"dem.sample", "how the DEs are placed", sample_keys},
     {"dem.sample.radius", "radius distribution of a packing (truncated Gaussian)", radius_distribution_keys},
+    {"dem.sample.yarn", "a weave's yarn", yarn_keys},
     {"dem.sample.particles[]", "one DE of build: particles", particle_keys},
     {"dem.bond", "bonds of every touching pair, one law", dem_bond_keys},
     {"dem.materials", "materials by name", materials_keys},
@@ -215,11 +236,53 @@ void read_particle_table(CaseNode& sample, Scene& scene, double density) {
   if (columns == 0 || p.size() == 0) throw InputError(file.string() + ": no DE in the table (dem.sample.table)");
 }
 
+constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packing", "weave"};
+
+// build: weave (dem/weave.hpp): the DEs, their springs and the groups of a 3D interlock.
+void read_weave(CaseNode& sample, Scene& scene) {
+  if (scene.continuum) sample.fail("build", "a weave cannot be coupled to a continuum yet");
+  dem::WeaveSpec spec;
+  const auto size = sample.numbers("size", Range::positive(), "m");
+  if (size.size() != 2) sample.fail("size", "expected the fabric's extent [along x, along y]");
+  spec.length_x = size[0], spec.length_y = size[1];
+  spec.weft_layers = int(sample.integer_or("weft_layers", 3, Range::at_least(2)));
+  spec.weft_spacing = sample.number("weft_spacing", Range::positive(), "m");
+  spec.warp_spacing = sample.number("warp_spacing", Range::positive(), "m");
+  spec.yarn_width = sample.number("yarn_width", Range::positive(), "m");
+  spec.yarn_thickness = sample.number("yarn_thickness", Range::positive(), "m");
+  const auto chains = sample.has("chains") ? sample.numbers("chains", Range::at_least(1), "1") : std::vector<double>{1.0, 1.0};
+  if (chains.size() != 2 || chains[0] != std::floor(chains[0]) || chains[1] != std::floor(chains[1]))
+    sample.fail("chains", "expected two whole numbers [across the width, through the thickness]");
+  spec.chains_across = int(chains[0]), spec.chains_through = int(chains[1]);
+  spec.crimp = sample.has("crimp") ? sample.number("crimp", Range::positive(), "1") : 0.0;
+  spec.clamp_width = sample.number_or("clamp_width", 0.0, Range::non_negative(), "m");
+  CaseNode yarn = sample.child("yarn");
+  spec.density = yarn.number("density", Range::positive(), "kg/m^3");
+  spec.modulus = yarn.number("modulus", Range::positive(), "Pa");
+  spec.section = yarn.has("section") ? yarn.number("section", Range::positive(), "m^2")
+                                     : std::numbers::pi * spec.yarn_width * spec.yarn_thickness / 4.0;
+  spec.failure_strain = yarn.number_or("failure_strain", 0.0, Range::non_negative(), "1");
+  yarn.finish();
+  // A rough count first (two yarn families crossing the fabric per column), against memory.
+  refuse_beyond_memory(sample, "size",
+                       spec.chains_across * spec.chains_through * spec.weft_layers *
+                           (spec.length_x / spec.weft_spacing * spec.length_y + spec.length_y / spec.warp_spacing * spec.length_x) /
+                           spec.yarn_thickness * spec.chains_through);
+  try {
+    scene.weave = dem::build_weave(scene.dem, spec);
+  } catch (const dem::WeaveError& e) {
+    sample.fail(e.field(), e.what());
+  }
+}
+
+// `density`: of the DEs built or listed (NaN with a weave and no dem.density: each listed DE
+// gives its own).
 void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptions& options) {
-  static constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packing"};
   dem::ParticleSet& p = scene.dem.particles;
   const std::string build = sample.choice("build", builders);
-  if (build == "packing") {
+  if (build == "weave") {
+    read_weave(sample, scene);
+  } else if (build == "packing") {
     read_packing(sample, scene, density, options);
   } else if (build == "lattice") {
     const Vec3 origin = sample.vec3_or("origin", {}, Range::any(), "m");
@@ -251,11 +314,25 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
   const bool table = build == "particles" && sample.has("table");
   if (table) read_particle_table(sample, scene, density);
   const auto listed = build == "particles" && !table ? sample.list("particles") : sample.list_or_empty("particles");
+  const std::size_t built = p.size();
   for (CaseNode item : listed) {
     const Vec3 x = item.vec3("position", Range::any(), "m");
     if (scene.continuum && !scene.continuum->in_dem_domain(x))
       item.fail("position", "this DE lies beyond the coupling overlap, in the pure-continuum zone");
-    const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), density);
+    // An impactor that starts inside a fabric would be shot out by the contact at once.
+    if (scene.weave) {
+      const double r = item.number("radius", Range::positive(), "m");
+      for (std::size_t j = 0; j < built; ++j)
+        if (norm(p.position[j] - x) < r + p.radius[j]) {
+          char where[160];
+          std::snprintf(where, sizeof where, "this DE starts inside the fabric: it overlaps the yarn DE at (%.4g, %.4g, %.4g) mm",
+                        p.position[j].x * 1e3, p.position[j].y * 1e3, p.position[j].z * 1e3);
+          item.fail("position", where);
+        }
+    }
+    const double own = item.has("density") ? item.number("density", Range::positive(), "kg/m^3") : density;
+    if (std::isnan(own)) item.fail("density", "expected this DE's density (there is no dem.density to fall back on)");
+    const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), own);
     p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
     item.finish();
   }
@@ -321,9 +398,9 @@ std::vector<std::string> read_materials(CaseNode dem_node, dem::DemModel& model,
     // The sample was built with unit density: scale the mass to the material's.
     p.inv_mass[i] /= list[material_of[i]].density;
   }
-  std::vector<int> group(list.size());
-  for (std::size_t m = 0; m < list.size(); ++m) group[m] = model.add_group(list[m].name);
-  for (std::size_t i = 0; i < p.size(); ++i) p.groups[i] |= dem::GroupMask{1} << group[material_of[i]];
+  std::vector<std::vector<std::uint32_t>> members(list.size());
+  for (std::size_t i = 0; i < p.size(); ++i) members[material_of[i]].push_back(static_cast<std::uint32_t>(i));
+  for (std::size_t m = 0; m < list.size(); ++m) model.add_group(list[m].name, std::move(members[m]));
 
   // One bond set per material with a bond law, and one for the interfaces.
   const double tolerance = dem_node.number_or("bond_tolerance", default_tolerance, Range::between(0.0, 1.0), "1");
@@ -421,7 +498,13 @@ std::span<const SchemaSection> dem_schema() { return dem_sections; }
 void read_dem(CaseNode dem_node, Scene& scene, const SceneOptions& options) {
   dem::DemModel& model = scene.dem;
   std::vector<std::string> materials;
-  if (dem_node.has("materials")) {
+  CaseNode sample = dem_node.child("sample");
+  if (sample.choice("build", builders) == "weave") {
+    for (const char* own : {"materials", "bond"})
+      if (dem_node.has(own)) dem_node.fail(own, "a weave makes its own springs (dem.sample.yarn); remove this key");
+    const double density = dem_node.has("density") ? dem_node.number("density", Range::positive(), "kg/m^3") : NAN;
+    read_sample(sample, scene, density, options);
+  } else if (dem_node.has("materials")) {
     for (const char* single : {"density", "bond"})
       if (dem_node.has(single))
         dem_node.fail(single, "give either dem.materials or dem.density and dem.bond, not both");
@@ -437,10 +520,13 @@ void read_dem(CaseNode dem_node, Scene& scene, const SceneOptions& options) {
     for (double r : model.particles.radius) mean_radius += r;
     mean_radius /= double(model.particles.size());
     const double skin = contact->number_or("skin", 0.2 * mean_radius, Range::positive(), "m");
-    model.set_contact(dem::make_contact_law(*contact), skin);
+    dem::ContactDefaults defaults;
+    if (scene.weave) defaults.stiffness = scene.weave->spring_stiffness;
+    model.set_contact(dem::make_contact_law(*contact, defaults), skin);
     contact->finish();
   }
   model.set_damping(dem_node.number_or("damping", 0.0, Range::non_negative(), "1/s"));
+  model.set_gravity(dem_node.vec3_or("gravity", {}, Range::any(), "m/s^2"));
   if (auto failure = dem_node.child_if("failure")) read_failure(*failure, model, materials);
   dem_node.finish();
 }

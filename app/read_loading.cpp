@@ -66,25 +66,22 @@ void read_groups(CaseNode root, dem::DemModel& model) {
   for (CaseNode g : root.list_or_empty("groups")) {
     const std::string name = g.string("name");
     if (model.group_index(name) >= 0) g.fail("name", "group '" + name + "' is defined twice");
-    if (model.group_names().size() >= static_cast<std::size_t>(dem::max_groups))
-      g.fail("name", "too many groups (at most 32)");
-    const int index = model.add_group(name);
-    const dem::GroupMask bit = dem::GroupMask{1} << index;
-    dem::ParticleSet& p = model.particles;
-    std::size_t count = 0;
+    const dem::ParticleSet& p = model.particles;
+    std::vector<std::uint32_t> ids;
     if (g.has("ids")) {
       for (double id : g.numbers("ids", Range::between(0, double(p.size()) - 1), "1")) {
         if (id != std::floor(id)) g.fail("ids", "expected whole DE indices");
-        p.groups[std::size_t(id)] |= bit, ++count;
+        ids.push_back(static_cast<std::uint32_t>(id));
       }
     } else {
       CaseNode region_node = g.child("region");
       const Region region = Region::read(region_node);
       region_node.finish();
       for (std::size_t i = 0; i < p.size(); ++i)
-        if (region.contains(p.position[i])) p.groups[i] |= bit, ++count;
+        if (region.contains(p.position[i])) ids.push_back(static_cast<std::uint32_t>(i));
     }
-    if (count == 0) g.fail(g.has("ids") ? "ids" : "region", "group '" + name + "' contains no DE");
+    if (ids.empty()) g.fail(g.has("ids") ? "ids" : "region", "group '" + name + "' contains no DE");
+    model.add_group(name, std::move(ids));
     g.finish();
   }
 }

@@ -687,6 +687,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   counts["particles"] = model.particles.size();
   if (scene.des_not_created > 0) counts["particles_not_created"] = scene.des_not_created;
   if (model.failure_enabled()) counts["broken_bonds"] = model.breaks().size();
+  if (!model.breaks().empty()) summary["first_break_time"] = model.breaks().front().time;  // s; events are in time order
   if (!model.bond_sets().empty()) {
     Json& bonds = counts["bonds"];
     for (const auto& set : model.bond_sets()) bonds[set->name] = set->size();

@@ -20,6 +20,7 @@
 #include "common/step_profile.hpp"
 #include "dem/dem_model.hpp"
 #include "dem/sample_file.hpp"
+#include "dem/weave.hpp"
 
 namespace arlequin::app {
 
@@ -99,6 +100,7 @@ struct Scene {
   std::unique_ptr<ContinuumPart> continuum;    // null without a continuum section
   std::unique_ptr<SceneModel> model;           // what the run steps (declared after what it refers to)
   std::optional<dem::SampleRecord> sample;     // with build: packing: its spec and report
+  std::optional<dem::WeaveReport> weave;       // with build: weave: what was built
   std::filesystem::path sample_file;           // where the packing is cached
   std::size_t des_not_created = 0;             // sample DEs beyond a coupling's overlap
   std::optional<std::array<Vec3, 3>> initial_gradient;  // initial_strain's H, by rows

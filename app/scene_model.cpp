@@ -52,6 +52,24 @@ std::unique_ptr<SceneModel> uncoupled_scene_model(dem::DemModel& dem, ContinuumP
   return std::make_unique<Uncoupled>(dem, continuum);
 }
 
+namespace {
+
+// Per DE, the index of the smallest group that holds it (of two as small, the later defined),
+// -1 for none: a yarn before its family, a material before the whole sample, so that ParaView
+// colours by the finest grouping a DE has.
+std::vector<std::int32_t> most_specific_group(const dem::DemModel& dem) {
+  std::vector<std::int32_t> group(dem.particles.size(), -1);
+  std::vector<std::size_t> size(dem.particles.size(), SIZE_MAX);
+  for (std::size_t g = 0; g < dem.group_names().size(); ++g) {
+    const auto& ids = dem.members(int(g));
+    for (const std::uint32_t i : ids)
+      if (ids.size() <= size[i]) size[i] = ids.size(), group[i] = std::int32_t(g);
+  }
+  return group;
+}
+
+}  // namespace
+
 void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const OutputPlan& plan) {
   const dem::ParticleSet& p = dem.particles;
   if (p.size() == 0) return;
@@ -62,8 +80,7 @@ void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const Outp
   fields.add_point_field("particles", "velocity", p.velocity);
   fields.add_point_field("particles", "angular_velocity", p.angular_velocity);
   fields.add_point_field("particles", "radius", p.radius);
-  const std::vector<std::int32_t> groups(p.groups.begin(), p.groups.end());
-  fields.add_point_field("particles", "groups", groups);
+  fields.add_point_field("particles", "group", most_specific_group(dem));
   if (dem.failure_enabled()) fields.add_point_field("particles", "damage", dem.damage());
   if (!plan.bond_fields || dem.bond_sets().empty()) return;
   std::vector<std::int64_t> lines;

@@ -2,7 +2,10 @@
 // Bonded-block benchmark (docs/validation.md R9, docs/performance.md): by default the case
 // cases/bonded_block_tension (20 x 20 x 50 spheres, ~57 600 beam bonds, bottom fixed, top pulled
 // at 0.1 m/s), 2000 steps with no output, on 1 and 2 OpenMP threads. Prints setup time, step
-// time, particle-steps/s, bond-steps/s and memory; with --repeat R the thread counts alternate R
+// time, particle-steps/s, bond-steps/s and memory; for a case with contact (cases/granular_bed,
+// cases/fabric_impact) also contact-steps/s (touching pairs summed over the steps, per second)
+// and the neighbour list's share of the step (its builds, timed apart); a case without bonds
+// is then ranked by contact-steps/s. With --repeat R the thread counts alternate R
 // times and the medians are printed; with --profile the phases of the step on each thread count
 // against one thread (common/step_profile.hpp).
 // The same for a virtual test run to its end (the REV failure test): --virtual-test SPEC --sample
@@ -95,7 +98,8 @@ Options parse(int argc, char** argv) {
 
 struct Timing {
   double seconds = 0.0;  // the time loop
-  double work = 0.0;     // bond-steps (block) or steps (virtual test)
+  double work = 0.0;     // bond-steps (block), contact-steps (a scene without bonds) or steps (virtual test)
+  const char* unit = "bond-steps/s";
 };
 
 // The block: build the case, run its steps with no output.
@@ -110,10 +114,16 @@ Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, 
   const double n = double(scene.dem.particles.size());
   double bonds = 0;
   for (const auto& set : scene.dem.bond_sets()) bonds += double(set->size());
+  // With contact the neighbour list is timed apart, by a profile of the run's own if none was asked.
+  const bool contact = scene.dem.has_contact();
+  arlequin::StepProfile own;
+  if (!profile && contact) profile = &own;
   scene.dem.set_profile(profile);
+  double contact_steps = 0.0;
   const auto t1 = Clock::now();
   for (long s = 0; s < o.steps; ++s) {
     scene.dem.step(scene.dt);
+    contact_steps += double(scene.dem.touching_contacts());
     if (profile) profile->count_step();
   }
   const double run = std::chrono::duration<double>(Clock::now() - t1).count();
@@ -125,11 +135,21 @@ Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, 
               "particle-steps/s %.3e, bond-steps/s %.3e, fingerprint %016llx\n",
               threads, n, bonds, setup, o.steps, run, 1e3 * run / o.steps, n * o.steps / run, bonds * o.steps / run,
               static_cast<unsigned long long>(print));
+  if (contact) {
+    double neighbour_seconds = 0.0;
+    for (const auto& phase : profile->phases())
+      if (phase.name == "neighbour list") neighbour_seconds = phase.seconds;
+    std::printf("  contact-steps/s %.3e (touching pairs per step %.0f, candidates %zu), neighbour list %zu builds, "
+                "%.3f ms/step (%.1f %% of the step)\n",
+                contact_steps / run, contact_steps / double(o.steps), scene.dem.neighbours()->pairs().size(),
+                scene.dem.neighbours()->builds(), 1e3 * neighbour_seconds / double(o.steps), 100.0 * neighbour_seconds / run);
+  }
   if (first)
     std::printf("  memory: scene %.1f MB resident = %.0f B per DE + bond pair (%.0f B/DE if all charged to DEs, "
                 "%.0f B/bond if all to bonds); peak RSS %.1f MB\n",
                 (rss_built - rss_before) / 1e6, (rss_built - rss_before) / (n + bonds), (rss_built - rss_before) / n,
                 (rss_built - rss_before) / bonds, memory_bytes().second / 1e6);
+  if (bonds == 0.0 && contact) return {run, contact_steps, "contact-steps/s"};
   return {run, bonds * o.steps};
 }
 
@@ -150,7 +170,7 @@ Timing run_virtual_test(const Options& o, int threads, arlequin::StepProfile& pr
   std::printf("threads %d: %s %s, %ld steps %.3f s (%.3f ms/step), fingerprint of series.csv %016llx\n", threads,
               o.sample.c_str(), o.test.c_str(), steps, run, 1e3 * run / double(std::max(steps, 1L)),
               static_cast<unsigned long long>(fingerprint(series.data(), series.size())));
-  return {run, double(steps)};
+  return {run, double(steps), "steps/s"};
 }
 
 double median(std::vector<double> v) {
@@ -174,13 +194,14 @@ int main(int argc, char** argv) try {
   // action components and two bond ends).
   using arlequin::Quat;
   using arlequin::Vec3;
-  constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 2 * sizeof(double) + sizeof(arlequin::dem::GroupMask);
+  constexpr std::size_t per_de = 6 * sizeof(Vec3) + sizeof(Quat) + 2 * sizeof(double);
   constexpr std::size_t per_bond = 2 * sizeof(std::uint32_t) + 5 * sizeof(double) + 2 * sizeof(Vec3) + 1 + 2 * sizeof(double);
   constexpr std::size_t per_bond_gather = 9 * sizeof(double) + 2 * sizeof(std::uint32_t);
   if (!virtual_test)
     std::printf("layout: %zu B per DE, %zu B per beam bond + %zu B of gather scratch (targets <= 200, <= 150)\n", per_de,
                 per_bond, per_bond_gather);
   std::map<int, std::vector<double>> rates;  // work per second of each run, by thread count
+  const char* unit = "";
   std::map<int, arlequin::StepProfile> profiles;
   for (int r = 0; r < o.repeat; ++r)
     for (int threads : o.threads) {
@@ -193,12 +214,12 @@ int main(int argc, char** argv) try {
       const Timing t = virtual_test ? run_virtual_test(o, threads, profile)
                                     : run_block(o, threads, o.profile ? &profile : nullptr, r == 0 && threads == o.threads.front());
       rates[threads].push_back(t.work / t.seconds);
+      unit = t.unit;
     }
   const double one = median(rates[1]);
   std::printf("median of %d run(s) per thread count, alternated:\n", o.repeat);
   for (const auto& [threads, list] : rates)
-    std::printf("  threads %2d: %s %.3e  speed-up vs 1 thread %.2fx\n", threads, virtual_test ? "steps/s" : "bond-steps/s",
-                median(list), median(list) / one);
+    std::printf("  threads %2d: %s %.3e  speed-up vs 1 thread %.2fx\n", threads, unit, median(list), median(list) / one);
   if (o.profile) {
     for (const auto& [threads, profile] : profiles) {
       if (threads == 1) std::printf("\n%s", profile.table().c_str());

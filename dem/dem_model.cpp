@@ -17,23 +17,34 @@ namespace arlequin::dem {
 
 int DemModel::add_group(const std::string& name) {
   if (const int g = group_index(name); g >= 0) return g;
-  if (group_names_.size() >= static_cast<std::size_t>(max_groups))
-    throw std::invalid_argument("too many groups (at most 32)");
   group_names_.push_back(name);
+  group_members_.emplace_back();
+  reaction_.emplace_back();
   return static_cast<int>(group_names_.size()) - 1;
+}
+
+int DemModel::add_group(const std::string& name, std::vector<std::uint32_t> ids) {
+  const int g = add_group(name);
+  add_members(g, ids);
+  return g;
+}
+
+void DemModel::add_members(int group, std::span<const std::uint32_t> ids) {
+  std::vector<std::uint32_t>& m = group_members_[group];
+  const auto old_end = m.insert(m.end(), ids.begin(), ids.end());  // the first inserted
+  if (!std::is_sorted(old_end, m.end())) std::sort(old_end, m.end());
+  std::inplace_merge(m.begin(), old_end, m.end());
+  m.erase(std::unique(m.begin(), m.end()), m.end());
+}
+
+void DemModel::watch_reaction(int group) {
+  const auto at = std::lower_bound(watched_.begin(), watched_.end(), group);
+  if (at == watched_.end() || *at != group) watched_.insert(at, group);
 }
 
 int DemModel::group_index(const std::string& name) const {
   const auto it = std::find(group_names_.begin(), group_names_.end(), name);
   return it == group_names_.end() ? -1 : static_cast<int>(it - group_names_.begin());
-}
-
-std::vector<std::uint32_t> DemModel::members(int group) const {
-  std::vector<std::uint32_t> out;
-  const GroupMask bit = GroupMask{1} << group;
-  for (std::size_t i = 0; i < particles.size(); ++i)
-    if (particles.groups[i] & bit) out.push_back(static_cast<std::uint32_t>(i));
-  return out;
 }
 
 BondSet& DemModel::add_bond_set(std::unique_ptr<BondSet> set) {
@@ -95,9 +106,10 @@ void DemModel::finalize() {
   constraint_reaction_.assign(constraints_.size(), Vec3{});
   condition_velocity_.assign(boundaries_.size(), Vec3{});
   watched_members_.clear();
-  for (std::size_t i = 0; i < particles.size(); ++i)
-    for (GroupMask m = particles.groups[i] & watched_; m; m &= m - 1)
-      watched_members_.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(std::countr_zero(m))});
+  for (const int g : watched_)
+    for (const std::uint32_t i : group_members_[g]) watched_members_.push_back({i, static_cast<std::uint32_t>(g)});
+  // In DE order (then group): the sums read the forces in memory order.
+  std::sort(watched_members_.begin(), watched_members_.end());
   driven_.assign(particles.size(), 0);
   for (const Constraint& c : constraints_) driven_[c.particle] |= c.imposed;
   if (damping_ > 0.0) {
@@ -119,7 +131,7 @@ void DemModel::finalize() {
     inv_mass_max_ = n > 0 ? *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end()) : 0.0;
     touching_.assign(n, 0);
   }
-  if (rdef_) rdef_->prepare(particles);
+  if (rdef_) rdef_->prepare(particles, group_members_);
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
   compute_forces();
@@ -169,7 +181,7 @@ void DemModel::set_profile(StepProfile* profile) {
   }
   if (contact_) phase_.contacts = profile->phase("contacts");
   if (failure_on_) phase_.failure = profile->phase("failure scan and breaks");
-  if (watched_) phase_.reactions = profile->phase("group reactions");
+  if (!watched_.empty()) phase_.reactions = profile->phase("group reactions");
   phase_.loads = profile->phase("loads and damping");
   phase_.finite = profile->phase("finite check");
 }
@@ -387,9 +399,9 @@ std::vector<double> DemModel::damage() const {
 
 void DemModel::record_reactions() {
   const ParticleSet& p = particles;
-  if (watched_) {
+  if (!watched_.empty()) {
     const PhaseTimer timer(profile_, phase_.reactions, false);
-    for (auto& r : reaction_) r = {};
+    for (const int g : watched_) reaction_[g] = {};
     for (const auto& [i, group] : watched_members_) reaction_[group] -= p.force[i];
   }
   const PhaseTimer timer(profile_, phase_.boundary, false);
@@ -412,6 +424,13 @@ void DemModel::apply_loads_and_damping() {
     const std::uint32_t i = loaded_[k].particle;
     p.force[i] += load_per_particle_[k];
     external_work_ += dot(load_per_particle_[k], p.velocity[i]) * last_dt_;
+  }
+  if (gravity_ != Vec3{}) {
+    const long n = static_cast<long>(p.size());
+    for_each_index(n, n > parallel_threshold, [&](long i) {
+      for (int k = 0; k < 3; ++k)
+        if (!(driven_[i] & (1 << k))) p.force[i][k] += p.mass(i) * gravity_[k];
+    });
   }
   if (damping_ > 0.0) {
     // Viscous damping from the half-step velocity, none on imposed components; split over the
@@ -462,6 +481,13 @@ Energies DemModel::energies() const {
   for (const auto& set : bond_sets_) e.bond += set->recorded_energy();
   if (contact_) e.contact = contact_->energy(*neighbours_, particles);
   e.external_work = external_work_;
+  // Gravity is conservative: its work is the drop of m g . x, exact whatever the path (driven
+  // components excluded: gravity does not act on them).
+  if (gravity_ != Vec3{})
+    for (std::size_t i = 0; i < particles.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        if (!(driven_[i] & (1 << k)))
+          e.external_work += particles.mass(i) * gravity_[k] * (particles.position[i][k] - particles.reference[i][k]);
   e.dissipated = dissipated_;
   e.fracture = fracture_;
   // Cohesive links still intact have dissipated part of their toughness; a failed link's share
@@ -478,14 +504,9 @@ Energies DemModel::energies() const {
 template <class Value>
 Vec3 DemModel::group_mean(int group, Value value) const {
   Vec3 sum{};
-  std::size_t count = 0;
-  const GroupMask bit = GroupMask{1} << group;
-  for (std::size_t i = 0; i < particles.size(); ++i)
-    if (particles.groups[i] & bit) {
-      sum += value(i);
-      ++count;
-    }
-  return count ? sum / static_cast<double>(count) : Vec3{};
+  const auto& ids = group_members_[group];
+  for (const std::uint32_t i : ids) sum += value(i);
+  return ids.empty() ? Vec3{} : sum / static_cast<double>(ids.size());
 }
 
 Vec3 DemModel::mean_displacement(int group) const {
@@ -496,10 +517,8 @@ double DemModel::group_energy(int group) const {
   use_energy_record();
   bond_energy_share_.assign(particles.size(), 0.0);
   for (const auto& set : bond_sets_) set->add_recorded_energy_per_particle(bond_energy_share_);
-  const GroupMask bit = GroupMask{1} << group;
   double e = 0.0;
-  for (std::size_t i = 0; i < particles.size(); ++i)
-    if (particles.groups[i] & bit) e += bond_energy_share_[i] + particle_kinetic_energy(i);
+  for (const std::uint32_t i : group_members_[group]) e += bond_energy_share_[i] + particle_kinetic_energy(i);
   return e;
 }
 

@@ -42,24 +42,33 @@ class DemModel {
  public:
   ParticleSet particles;
 
-  // Groups: up to 32 names, membership in particles.groups bits.
+  // Groups: named sets of DEs, as many as a scene needs (a weave has one per yarn), each kept
+  // as its members' indices in increasing order. add_group returns the index of the group of
+  // that name, made empty if new; add_members merges DEs into it (repeats are kept once).
   int add_group(const std::string& name);
+  int add_group(const std::string& name, std::vector<std::uint32_t> ids);
+  void add_members(int group, std::span<const std::uint32_t> ids);
   int group_index(const std::string& name) const;  // -1 if unknown
   const std::vector<std::string>& group_names() const { return group_names_; }
-  std::vector<std::uint32_t> members(int group) const;
+  const std::vector<std::uint32_t>& members(int group) const { return group_members_[group]; }
 
   BondSet& add_bond_set(std::unique_ptr<BondSet> set);
   const std::vector<std::unique_ptr<BondSet>>& bond_sets() const { return bond_sets_; }
   void set_contact(std::unique_ptr<ContactLaw> law, double skin);
   bool has_contact() const { return contact_ != nullptr; }
   const NeighbourList* neighbours() const { return neighbours_ ? &*neighbours_ : nullptr; }
+  // Pairs that touched in the last force pass (0 without contact).
+  std::size_t touching_contacts() const { return deepest_contact_.touching; }
   void add_boundary(const BoundaryCondition& bc);
   // DEs whose motion a kinematic condition imposes (valid before finalize()).
   std::vector<std::uint32_t> driven_particles() const;
   // Viscous damping, force -c m v and torque -c I omega, c in 1/s (quasi-static runs).
   void set_damping(double coefficient) { damping_ = coefficient; }
+  // A uniform body force m g on every DE (m/s^2), on the components no kinematic condition
+  // imposes; its work is the drop of the potential, sum of m g . (x - x_reference).
+  void set_gravity(const Vec3& g) { gravity_ = g; }
   // Reaction forces of this group are recorded every step (for force sensors); before finalize().
-  void watch_reaction(int group) { watched_ |= GroupMask{1} << group; }
+  void watch_reaction(int group);
 
   // Arlequin weighting (docs/theory.md#weighted-models): every DE's mass (and so its inertia) is
   // multiplied by max(alpha(x_i), mass_floor), every bond's stiffness by alpha at its
@@ -176,6 +185,7 @@ class DemModel {
     std::uint8_t imposed;     // bits 0-2: the condition imposes x, y, z; bit 3: it locks rotation
   };
   std::vector<std::string> group_names_;
+  std::vector<std::vector<std::uint32_t>> group_members_;  // per group, increasing DE indices
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
   std::unique_ptr<ContactLaw> contact_;
   std::optional<NeighbourList> neighbours_;
@@ -200,9 +210,10 @@ class DemModel {
   bool energy_record_requested_ = false;  // record_energies_in_next_step()
   long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
   mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE
-  GroupMask watched_ = 0;
-  Vec3 reaction_[max_groups]{};
+  std::vector<int> watched_;      // the groups whose reactions are recorded, increasing
+  std::vector<Vec3> reaction_;   // per group (zero for those not watched), N
   double damping_ = 0.0;
+  Vec3 gravity_{};  // m/s^2
   std::vector<Vec3> damping_force_, damping_torque_;  // this step's, kept for both half kicks
   // The step's phases in profile_ (set_profile), one per bond set in bonds.
   StepProfile* profile_ = nullptr;

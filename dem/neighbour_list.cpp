@@ -32,29 +32,48 @@ void NeighbourList::build(const ParticleSet& p) {
   ++builds_;
   if (n < 2) return;
   Vec3 lo = p.position[0], hi = p.position[0];
-  double r_max = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
       lo[k] = std::min(lo[k], p.position[i][k]);
       hi[k] = std::max(hi[k], p.position[i][k]);
     }
-    r_max = std::max(r_max, p.radius[i]);
-  }
+  // A DE far larger than the median (an impactor among yarn DEs) would make every cell its
+  // size and each cell hold hundreds of DEs: such DEs stay out of the cells and are tested
+  // against every DE instead, O(n) each.
+  std::vector<double>& radii = scratch_radius_;
+  radii.assign(p.radius.begin(), p.radius.end());
+  std::nth_element(radii.begin(), radii.begin() + n / 2, radii.end());
+  const double large = large_radius_ratio * radii[n / 2];
+  double r_max = 0.0;
+  large_.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (p.radius[i] > large) large_.push_back(static_cast<std::uint32_t>(i));
+    else r_max = std::max(r_max, p.radius[i]);
   // Cell edge >= the largest interaction distance, so only the 27 surrounding cells matter;
   // grown if needed to keep coordinates within 21 bits (very sparse scenes).
   double h = 2.0 * r_max + skin_;
   for (int k = 0; k < 3; ++k) h = std::max(h, (hi[k] - lo[k]) / 2.0e6);
-  cells_.resize(n);
+  cells_.clear();
   for (std::size_t i = 0; i < n; ++i) {
+    if (p.radius[i] > large) continue;
     const Vec3& x = p.position[i];
-    cells_[i] = {cell_key(static_cast<std::int64_t>((x.x - lo.x) / h) + 1,
-                          static_cast<std::int64_t>((x.y - lo.y) / h) + 1,
-                          static_cast<std::int64_t>((x.z - lo.z) / h) + 1),
-                 static_cast<std::uint32_t>(i)};
+    cells_.push_back({cell_key(static_cast<std::int64_t>((x.x - lo.x) / h) + 1, static_cast<std::int64_t>((x.y - lo.y) / h) + 1,
+                               static_cast<std::int64_t>((x.z - lo.z) / h) + 1),
+                      static_cast<std::uint32_t>(i)});
   }
   std::sort(cells_.begin(), cells_.end());
+  const auto consider = [&](std::uint32_t i, std::uint32_t j) {
+    const double reach = p.radius[i] + p.radius[j] + skin_;
+    if (norm2(p.position[j] - p.position[i]) >= reach * reach) return;
+    const std::uint32_t lo_id = std::min(i, j), hi_id = std::max(i, j);
+    if (std::binary_search(excluded_.begin(), excluded_.end(), key_of(lo_id, hi_id))) return;
+    pairs_.emplace_back(lo_id, hi_id);
+  };
+  for (std::size_t a = 0; a < large_.size(); ++a)
+    for (std::uint32_t j = 0; j < n; ++j)
+      if (p.radius[j] <= large || j > large_[a]) consider(large_[a], j);
   constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
-  for (std::size_t a = 0; a < n; ++a) {
+  for (std::size_t a = 0; a < cells_.size(); ++a) {
     const auto [key, i] = cells_[a];
     const std::int64_t cx = key >> 42, cy = (key >> 21) & mask, cz = key & mask;
     for (int dx = -1; dx <= 1; ++dx)
@@ -67,12 +86,7 @@ void NeighbourList::build(const ParticleSet& p) {
           for (; it != cells_.end() && it->first == other; ++it) {
             const std::uint32_t j = it->second;
             if (other == key && j <= i) continue;
-            const double reach = p.radius[i] + p.radius[j] + skin_;
-            if (norm2(p.position[j] - p.position[i]) >= reach * reach) continue;
-            const std::uint32_t lo_id = std::min(i, j), hi_id = std::max(i, j);
-            if (std::binary_search(excluded_.begin(), excluded_.end(), key_of(lo_id, hi_id)))
-              continue;
-            pairs_.emplace_back(lo_id, hi_id);
+            consider(i, j);
           }
         }
   }

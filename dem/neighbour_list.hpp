@@ -34,12 +34,18 @@ class NeighbourList {
   void save_state(StateArchive& archive, const std::string& prefix) const;
   void load_state(const StateArchive& archive, const std::string& prefix, std::size_t n_particles);
 
+  // A DE of a radius above this ratio to the median is tested against every DE rather than
+  // binned: the cells stay the size of the many small DEs.
+  static constexpr double large_radius_ratio = 4.0;
+
  private:
   double skin_;
   std::vector<std::uint64_t> excluded_;  // sorted keys i * 2^32 + j
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
   std::vector<Vec3> position_at_build_;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> cells_;  // (cell key, DE), sorted
+  std::vector<std::uint32_t> large_;   // DEs kept out of the cells (build's scratch)
+  std::vector<double> scratch_radius_;  // build's scratch, for the median radius
   std::size_t builds_ = 0;
 };
 

@@ -19,7 +19,6 @@ std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
   torque.push_back({});
   radius.push_back(r);
   inv_mass.push_back(1.0 / m);
-  groups.push_back(0);
   return size() - 1;
 }
 

@@ -15,10 +15,6 @@
 
 namespace arlequin::dem {
 
-// Up to 32 named groups; a DE's membership is a bit mask.
-using GroupMask = std::uint32_t;
-inline constexpr int max_groups = 32;
-
 struct ParticleSet {
   std::vector<Vec3> position;         // m
   std::vector<Vec3> reference;        // m, position at t = 0 (for displacements)
@@ -29,7 +25,6 @@ struct ParticleSet {
   std::vector<Vec3> torque;           // N m, accumulated each step
   std::vector<double> radius;         // m
   std::vector<double> inv_mass;       // 1/kg
-  std::vector<GroupMask> groups;
 
   std::size_t size() const { return position.size(); }
 
@@ -53,7 +48,7 @@ struct ParticleSet {
   template <class F>
   void for_each_array(F f) {
     f(position), f(reference), f(velocity), f(orientation), f(angular_velocity);
-    f(force), f(torque), f(radius), f(inv_mass), f(groups);
+    f(force), f(torque), f(radius), f(inv_mass);
   }
   void move_entry(std::size_t from, std::size_t to);
   void resize(std::size_t n);

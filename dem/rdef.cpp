@@ -11,16 +11,15 @@
 
 namespace arlequin::dem {
 
-void RdefCriterion::prepare(const ParticleSet& p) {
+void RdefCriterion::prepare(const ParticleSet& p, const std::vector<std::vector<std::uint32_t>>& group_members) {
   threshold_.assign(p.size(), settings_.threshold);
   class_.assign(p.size(), -1);
-  for (std::size_t i = 0; i < p.size(); ++i)
-    for (std::size_t g = 0; g < settings_.group_thresholds.size(); ++g)
-      if (p.groups[i] & (GroupMask{1} << settings_.group_thresholds[g].first)) {
-        threshold_[i] = settings_.group_thresholds[g].second;
-        class_[i] = static_cast<int>(g);
-        break;
-      }
+  // Last to first, so that the first listed group holding a DE sets its threshold.
+  for (std::size_t g = settings_.group_thresholds.size(); g-- > 0;)
+    for (const std::uint32_t i : group_members[settings_.group_thresholds[g].first]) {
+      threshold_[i] = settings_.group_thresholds[g].second;
+      class_[i] = static_cast<int>(g);
+    }
   omega_ = settings_.volume == RdefVolume::laguerre ? laguerre_volumes(p.reference, p.radius)
                                                     : sphere_volume_shares(p, settings_.compaction);
   for (std::size_t i = 0; i < p.size(); ++i)

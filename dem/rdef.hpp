@@ -36,8 +36,10 @@ class RdefCriterion {
  public:
   explicit RdefCriterion(RdefSettings settings) : settings_(std::move(settings)) {}
 
-  // Each DE's threshold, threshold group and volume share. InputError for an empty Laguerre cell.
-  void prepare(const ParticleSet& p);
+  // Each DE's threshold (that of the first of settings.group_thresholds whose group holds it;
+  // group_members: per group, its DEs), threshold group and volume share. InputError for an
+  // empty Laguerre cell.
+  void prepare(const ParticleSet& p, const std::vector<std::vector<std::uint32_t>>& group_members);
   // Makes `scan` accumulate every intact bond's virial, on the branch the volumes ask for.
   void scan_into(ForceScan& scan);
   // The events of every intact bond one of whose DEs reached its threshold, in the configuration

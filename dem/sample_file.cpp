@@ -212,7 +212,6 @@ void write_file(const SampleIo& io, hid_t file, const ParticleSet& p, const Pack
                          H5Gclose);
   io.write_dataset(particles, "position", H5T_NATIVE_DOUBLE, p.size(), 3, p.position.data());
   io.write_dataset(particles, "radius", H5T_NATIVE_DOUBLE, p.size(), 1, p.radius.data());
-  io.write_dataset(particles, "groups", H5T_NATIVE_UINT32, p.size(), 1, p.groups.data());
 
   const Handle packing(
       io.check(H5Gcreate2(file, "packing", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "cannot create group packing"),
@@ -272,9 +271,7 @@ SampleRecord load_sample(const std::filesystem::path& path, ParticleSet& p, doub
   const Handle particles(io.check(H5Gopen2(file, "particles", H5P_DEFAULT), "cannot open group particles"), H5Gclose);
   const auto position = io.read_dataset<Vec3>(particles, "position", H5T_NATIVE_DOUBLE, 3);
   const auto radius = io.read_dataset<double>(particles, "radius", H5T_NATIVE_DOUBLE, 1);
-  const auto groups = io.read_dataset<GroupMask>(particles, "groups", H5T_NATIVE_UINT32, 1);
-  if (radius.size() != position.size() || groups.size() != position.size())
-    io.fail("particles/position, radius and groups have different lengths");
+  if (radius.size() != position.size()) io.fail("particles/position and radius have different lengths");
 
   if (H5Lexists(file, "packing", H5P_DEFAULT) <= 0) io.fail("no group packing");
   const Handle packing(io.check(H5Gopen2(file, "packing", H5P_DEFAULT), "cannot open group packing"), H5Gclose);
@@ -293,7 +290,7 @@ SampleRecord load_sample(const std::filesystem::path& path, ParticleSet& p, doub
   for (std::size_t k = 0; k < centres.size(); ++k) record.report.radius_histogram.emplace_back(centres[k], counts[k]);
 
   p.reserve(p.size() + position.size());
-  for (std::size_t i = 0; i < position.size(); ++i) p.groups[p.add(position[i], radius[i], density)] = groups[i];
+  for (std::size_t i = 0; i < position.size(); ++i) p.add(position[i], radius[i], density);
   return record;
 }
 

@@ -5,6 +5,9 @@
 // Parameters (case file dem.material.bond):
 //   stiffness       K [N/m]. For a yarn of n_p DEs per n_s springs, seed Eq. 8 gives
 //                   K_mu = (n_s / n_p) K_M from the yarn's macroscopic stiffness K_M.
+//   axial_rigidity  EA [N], instead of stiffness: each spring gets K = EA / L0 from its own rest
+//                   length, a bar of that rigidity (for n_s equal springs in a chain of length
+//                   L_y, K = n_s EA / L_y: seed Eq. 8 with EA = E S / n_p).
 //   max_elongation  [1], optional: the spring breaks when (|d| - L0) / L0 reaches it
 //                   (elastic-brittle yarn); 0 = unbreakable.
 // Central force: no torque, so the DEs' rotations are untouched. Stiffness bound: K per bond
@@ -21,6 +24,12 @@ class SpringBondSet final : public BondKernelSet<SpringBondSet> {
   static constexpr FailureCriterion criterion = FailureCriterion::elongation;
 
   SpringBondSet(double stiffness, double max_elongation = 0.0) : nominal_stiffness_(stiffness), max_elongation_(max_elongation) {}
+  // Springs of axial rigidity EA (N): K = EA / L0 per spring.
+  static std::unique_ptr<SpringBondSet> with_axial_rigidity(double EA, double max_elongation = 0.0) {
+    auto set = std::make_unique<SpringBondSet>(0.0, max_elongation);
+    set->axial_rigidity_ = EA;
+    return set;
+  }
   static std::unique_ptr<BondSet> make(CaseNode& section);
   static std::span<const KeyDoc> keys();  // what make() reads
 
@@ -47,10 +56,12 @@ class SpringBondSet final : public BondKernelSet<SpringBondSet> {
   double strength() const { return max_elongation_; }
   void reorder(std::span<const std::uint32_t> order);
   void scale(std::size_t b, double factor) { stiffness_[b] *= factor; }
+  double stiffness_of(std::size_t b) const { return stiffness_[b]; }  // N/m
   void add_frequency_bound(std::size_t b, const ParticleSet& p, std::span<double> translational, std::span<double>) const;
 
  private:
   double nominal_stiffness_;         // K of the case file, N/m
+  double axial_rigidity_ = 0.0;      // EA, N; > 0: K = EA / L0 instead of the nominal K
   double max_elongation_;            // 0 = unbreakable
   std::vector<double> stiffness_;    // K per bond (weighted), N/m
   std::vector<double> rest_length_;  // L0, m

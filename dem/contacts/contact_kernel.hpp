@@ -45,7 +45,8 @@ class ContactKernelLaw : public ContactLaw {
       if (count) ++touching[i], ++touching[j];
       if (mu > 0.0) pass.friction_power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
       const double depth = (reach - distance) / std::min(p.radius[i], p.radius[j]);
-      if (depth > pass.deepest) pass = {pass.friction_power, depth, i, j};
+      ++pass.touching;
+      if (depth > pass.deepest) pass = {pass.friction_power, depth, i, j, pass.touching};
     }
     return pass;
   }

@@ -30,6 +30,7 @@ struct ContactPass {
   double friction_power = 0.0;  // W, >= 0
   double deepest = 0.0;         // largest overlap / min(R_i, R_j) over the touching pairs
   std::uint32_t first = 0, second = 0;  // that pair
+  std::size_t touching = 0;     // touching pairs
 };
 
 class ContactLaw {
@@ -42,14 +43,20 @@ class ContactLaw {
   virtual double stiffness() const = 0;
 };
 
+// What the sample suggests for keys the case leaves out: a weave's contacts take its springs'
+// stiffness (seed, below Eq. 9). 0: no suggestion, the key is required.
+struct ContactDefaults {
+  double stiffness = 0.0;  // N/m
+};
+
 // Registry of contact laws, keyed by the case-file name (dem.contact.law).
 struct ContactLawEntry {
   std::string_view name;
   std::string_view summary;
-  std::unique_ptr<ContactLaw> (*make)(CaseNode& parameters);
+  std::unique_ptr<ContactLaw> (*make)(CaseNode& parameters, const ContactDefaults& defaults);
   std::span<const KeyDoc> (*keys)();  // its own keys: schema section "contact (law: name)"
 };
 std::span<const ContactLawEntry> contact_laws();
-std::unique_ptr<ContactLaw> make_contact_law(CaseNode& contact_section);
+std::unique_ptr<ContactLaw> make_contact_law(CaseNode& contact_section, const ContactDefaults& defaults = {});
 
 }  // namespace arlequin::dem

@@ -16,8 +16,8 @@ std::span<const ContactLawEntry> contact_laws() {
   return table;
 }
 
-std::unique_ptr<ContactLaw> make_contact_law(CaseNode& section) {
-  return choose_entry(contact_laws(), section, "law", "contact").make(section);
+std::unique_ptr<ContactLaw> make_contact_law(CaseNode& section, const ContactDefaults& defaults) {
+  return choose_entry(contact_laws(), section, "law", "contact").make(section, defaults);
 }
 
 }  // namespace arlequin::dem

@@ -119,7 +119,7 @@ inline void build_four_lines(dem::DemModel& model, int n, double a, double b, do
     for (int k = 0; k < n; ++k) {
       const std::size_t i = p.add(corners[l] + Vec3{k * a, 0, 0}, 0.5 * a, rho);
       p.inv_mass[i] = 1.0 / (rho * areas[l] * a);
-      if (k == 0) p.groups[i] |= dem::GroupMask{1} << left;
+      if (k == 0) model.add_members(left, std::array{static_cast<std::uint32_t>(i)});
     }
     auto& set = (l == 0 || l == 3) ? *stiff : *soft;
     for (int k = 0; k + 1 < n; ++k)
@@ -157,7 +157,7 @@ inline void build_block(dem::DemModel& model, std::array<int, 3> n, double a, do
       for (int i = 0; i < n[0]; ++i) {
         const std::size_t id = p.add({i * a, j * a, l * a}, 0.5 * a, rho);
         p.inv_mass[id] = 1.0 / (rho * a * a * a * cells_share({i, j, l}, {0, 0, 0}));
-        if (i == 0) p.groups[id] |= dem::GroupMask{1} << left;
+        if (i == 0) model.add_members(left, std::array{static_cast<std::uint32_t>(id)});
       }
   auto springs = std::make_unique<dem::SpringBondSet>(k);
   std::vector<double> factor;

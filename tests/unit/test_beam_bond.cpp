@@ -176,10 +176,8 @@ TEST(BeamChain, ClampedCantileverRelaxesToBeamTheory) {
   DemModel model;
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 11, 2e-3, 1e-3, 7800.0);
   test::bond_all_touching(model, {1e11, 0.3, 0.5});
-  model.particles.groups[0] = 1;
-  model.particles.groups[10] = 2;
-  model.add_group("clamp");
-  model.add_group("tip");
+  model.add_group("clamp", {0});
+  model.add_group("tip", {10});
   model.add_boundary({"clamp", BoundaryKind::fixed, {}, 0.0, true});
   model.add_boundary({"tip", BoundaryKind::force, {0, 0.01, 0}, 0.0, false});
   model.set_damping(400.0);

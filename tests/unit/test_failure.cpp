@@ -205,8 +205,11 @@ TEST(ForceScan, RecordedEnergiesAreThoseOfABondPass) {
   const double dt = build_breakable_model(recorded, {6, 5, 5});
   build_breakable_model(evaluated, {6, 5, 5});
   constexpr int group = 0;  // every third DE
-  for (DemModel* m : {&recorded, &evaluated})
-    for (std::size_t i = 0; i < m->particles.size(); i += 3) m->particles.groups[i] |= GroupMask{1} << group;
+  for (DemModel* m : {&recorded, &evaluated}) {
+    std::vector<std::uint32_t> every_third;
+    for (std::uint32_t i = 0; i < m->particles.size(); i += 3) every_third.push_back(i);
+    ASSERT_EQ(m->add_group("every_third", every_third), group);
+  }
   std::size_t steps_with_breaks = 0;
   for (int n = 0; n < 40; ++n) {
     if (n % 3 != 2) recorded.record_energies_in_next_step();  // every third step: none
@@ -498,9 +501,7 @@ TEST(Rdef, EachGroupFailsAtItsOwnThreshold) {
   const double R = 1e-3;
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
   test::bond_all_touching(model, {2e11, 0.3, 0.5});
-  const int hub = model.add_group("hub"), side = model.add_group("side");
-  model.particles.groups[2] |= GroupMask{1} << hub;
-  model.particles.groups[1] |= GroupMask{1} << side;
+  const int hub = model.add_group("hub", {2}), side = model.add_group("side", {1});
   DemModel::RdefSettings settings{1.5e7, RdefEquivalent::max_principal, 0.63, {}};
   settings.group_thresholds = {{hub, 3.0e7}, {side, 1.0e7}};
   model.enable_rdef(settings);
@@ -555,8 +556,7 @@ TEST(Rdef, AverageLeavesOutPartnersOfAnotherThresholdGroup) {
   const double R = 1e-3;
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 5, 2 * R, R, 7800.0);
   test::bond_all_touching(model, {2e11, 0.3, 0.5});
-  const int other = model.add_group("other");
-  model.particles.groups[3] |= GroupMask{1} << other;
+  const int other = model.add_group("other", {3});
   for (std::size_t i : {0u, 1u}) model.particles.position[i].x -= 1e-6;
   for (std::size_t i : {3u, 4u}) model.particles.position[i].x += 1e-6;
   const double sigma_1 = model.virial_stress(0.63)[1][0];

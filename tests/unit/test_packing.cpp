@@ -123,7 +123,6 @@ TEST_F(SampleFileTest, TenThousandDesInABoxAreDenseIsotropicAndSaved) {
   EXPECT_NEAR(static_cast<double>(hits) / points, report.compaction, 0.005);
 
   // Save -> load gives the same DEs and the same record, bit for bit.
-  p.groups[7] = 0b101;
   const fs::path file = dir_ / "sub" / "sample.h5";
   save_sample(file, p, spec, report);
   EXPECT_FALSE(fs::exists(file.string() + ".tmp." + std::to_string(::getpid())));
@@ -131,7 +130,6 @@ TEST_F(SampleFileTest, TenThousandDesInABoxAreDenseIsotropicAndSaved) {
   const SampleRecord record = load_sample(file, q, 1750.0);
   EXPECT_TRUE(same_bits(q.position, p.position));
   EXPECT_TRUE(same_bits(q.radius, p.radius));
-  EXPECT_TRUE(same_bits(q.groups, p.groups));
   EXPECT_TRUE(same_bits(q.inv_mass, p.inv_mass));
   const auto& loaded_box = std::get<Box>(record.spec.region.shape());
   EXPECT_TRUE(loaded_box.lower == box.lower && loaded_box.upper == box.upper);
@@ -261,7 +259,6 @@ TEST(Samples, KeepOnlyDropsDesAndKeepsTheOthersInOrder) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     p.velocity[i] = {double(i), 0, 0};
     p.radius[i] = 1.0 + 0.1 * double(i);
-    p.groups[i] = GroupMask(1u << i);
   }
   const std::size_t dropped = p.keep_only([&](std::size_t i) { return i % 2 == 1; });
   EXPECT_EQ(dropped, 3u);
@@ -272,10 +269,9 @@ TEST(Samples, KeepOnlyDropsDesAndKeepsTheOthersInOrder) {
     EXPECT_EQ(p.reference[k].x, 2.0 * double(i));
     EXPECT_EQ(p.velocity[k].x, double(i));
     EXPECT_EQ(p.radius[k], 1.0 + 0.1 * double(i));
-    EXPECT_EQ(p.groups[k], GroupMask(1u << i));
   }
   for (std::size_t n : {p.reference.size(), p.velocity.size(), p.orientation.size(), p.angular_velocity.size(),
-                        p.force.size(), p.torque.size(), p.radius.size(), p.inv_mass.size(), p.groups.size()})
+                        p.force.size(), p.torque.size(), p.radius.size(), p.inv_mass.size()})
     EXPECT_EQ(n, 3u);
 }
 

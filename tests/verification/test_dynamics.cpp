@@ -135,8 +135,7 @@ TEST(BondedChain, PulseTravelsAtTheLongWaveSpeed) {
   const int n = 400, probe = 300;
   build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, n, L0, R, steel);
   test::bond_all_touching(model, beam);
-  model.particles.groups[0] = 1;
-  model.add_group("driver");
+  model.add_group("driver", {0});
   const double v0 = 1e-3;
   model.add_boundary({"driver", BoundaryKind::velocity, {v0, 0, 0}, 0.0, false});
   model.finalize();
@@ -155,6 +154,33 @@ TEST(BondedChain, PulseTravelsAtTheLongWaveSpeed) {
   }
   const double speed = probe * L0 / arrival;
   EXPECT_NEAR(speed, c, 0.02 * c);
+}
+
+// Gravity: velocity Verlet integrates a constant force exactly, so a free DE falls by g t^2 / 2
+// and reaches g t to round-off; a fixed DE does not fall and gravity does no work on it; the
+// kinetic energy gained is gravity's work (the potential's drop), so the balance is zero.
+TEST(Gravity, AFreeDeFallsByTheClosedFormAndTheBalanceHolds) {
+  DemModel model;
+  const double R = 1e-3;
+  model.particles.add({0, 0, 0}, R, steel);
+  model.particles.add({1, 0, 0}, R, steel);
+  model.particles.velocity[0] = {0.5, 0, 0};
+  model.add_group("held", {1});
+  model.add_boundary({"held", BoundaryKind::fixed, {}, 0.0, false});
+  const Vec3 g{0, 0, -9.81};
+  model.set_gravity(g);
+  model.finalize();
+  const double e0 = model.energies().total();
+  const double dt = 1e-4;
+  for (int n = 0; n < 1000; ++n) model.step(dt);
+  const double t = model.time();
+  EXPECT_NEAR(model.particles.position[0].z, 0.5 * g.z * t * t, 1e-12);
+  EXPECT_NEAR(model.particles.position[0].x, 0.5 * t, 1e-12);
+  EXPECT_NEAR(model.particles.velocity[0].z, g.z * t, 1e-12);
+  EXPECT_EQ(model.particles.position[1].z, 0.0);
+  const auto e = model.energies();
+  EXPECT_NEAR(e.external_work, model.particles.mass(0) * 9.81 * 9.81 * t * t / 2, 1e-12 * e.kinetic);
+  EXPECT_NEAR(e.balance(e0), 0.0, 1e-12 * e.kinetic);
 }
 
 TEST(PenaltyContact, HeadOnImpactConservesEnergy) {
@@ -248,6 +274,38 @@ TEST(PenaltyContact, FrictionOpposesSlidingWithTheCoulombForce) {
     EXPECT_NEAR(p.torque[0].z, arm * f_t, 1e-9 * R * f_t);
     EXPECT_NEAR(power, f_t * v, 1e-9 * f_t * v);
   }
+}
+
+// The neighbour list keeps a DE far larger than the median (an impactor) out of its cells and
+// tests it against every DE: the pairs are those of a brute-force search over all pairs
+// (within R_i + R_j + skin, excluded pairs left out), with the impactor among small DEs, a
+// second impactor near it, and small DEs at a distance from both.
+TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
+  ParticleSet p;
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double r = 1e-4, skin = 3e-5;
+  for (int k = 0; k < 1500; ++k) p.add({u(rng) * 8e-3, u(rng) * 8e-3, u(rng) * 2e-3}, r * (0.9 + 0.2 * u(rng)), 1000.0);
+  p.add({4e-3, 4e-3, 2.5e-3}, 2e-3, 7530.0);   // the impactor, touching the bed
+  p.add({4e-3, 7e-3, 3.3e-3}, 1.5e-3, 7530.0);  // another, touching the first and the bed
+  const std::uint32_t n = static_cast<std::uint32_t>(p.size());
+  NeighbourList list(skin);
+  list.set_exclusions({{3, 4}, {n - 2, 17}});
+  list.build(p);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> expected;
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      if ((i == 3 && j == 4) || (i == 17 && j == n - 2)) continue;
+      const double reach = p.radius[i] + p.radius[j] + skin;
+      if (norm2(p.position[j] - p.position[i]) < reach * reach) expected.emplace_back(i, j);
+    }
+  const auto pairs = list.pairs();
+  EXPECT_EQ(std::vector(pairs.begin(), pairs.end()), expected);
+  // The case is the one it is meant to be: both large DEs have many neighbours, and meet.
+  const auto with = [&](std::uint32_t d) { return std::count_if(expected.begin(), expected.end(), [&](auto q) { return q.first == d || q.second == d; }); };
+  EXPECT_GT(with(n - 2), 50);
+  EXPECT_GT(with(n - 1), 10);
+  EXPECT_NE(std::find(expected.begin(), expected.end(), std::pair{n - 2, n - 1}), expected.end());
 }
 
 TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
