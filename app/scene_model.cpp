@@ -86,6 +86,10 @@ void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const Outp
   std::vector<std::int64_t> lines;
   std::vector<std::int32_t> set_of, broken;
   std::vector<double> damage;  // 0 or 1 (broken), or a cohesive link's softening damage
+  // The stretch of the line between the bond's DEs, |x_j - x_i| / |X_j - X_i| - 1 (X the
+  // positions at t = 0, where every bond is made at rest): a spring's elongation, its failure
+  // measure; for a beam the axial strain of its centre line.
+  std::vector<double> strain;
   for (std::size_t s = 0; s < dem.bond_sets().size(); ++s) {
     const dem::BondSet& set = *dem.bond_sets()[s];
     const auto softening = set.damage_values();
@@ -95,12 +99,15 @@ void write_dem_fields(const dem::DemModel& dem, FieldsWriter& fields, const Outp
       set_of.push_back(static_cast<std::int32_t>(s));
       broken.push_back(set.broken()[b]);
       damage.push_back(softening.empty() ? set.broken()[b] : softening[b]);
+      const std::uint32_t i = set.first()[b], j = set.second()[b];
+      strain.push_back(norm(p.position[j] - p.position[i]) / norm(p.reference[j] - p.reference[i]) - 1.0);
     }
   }
   fields.add_grid_sharing_points("bonds", "particles", FieldsWriter::CellKind::Line, lines);
   fields.add_cell_field("bonds", "bond_set", set_of);
   fields.add_cell_field("bonds", "broken", broken);
   fields.add_cell_field("bonds", "damage", damage);
+  fields.add_cell_field("bonds", "strain", strain);
 }
 
 }  // namespace arlequin::app

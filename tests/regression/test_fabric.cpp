@@ -9,6 +9,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <hdf5.h>
+
 #include "common/json.hpp"
 #include "support/cli.hpp"
 
@@ -31,15 +33,24 @@ double worst_balance(const std::vector<std::map<std::string, std::string>>& rows
   return worst;
 }
 
+// The reduced impact with `sets` (--set options) run into the scratch folder `name` (out): its
+// series rows, none if the run failed (which is reported).
+std::vector<std::map<std::string, std::string>> run_reduced(const std::string& name, const std::string& sets,
+                                                           std::filesystem::path& out) {
+  out = test::scratch_dir(name);
+  const auto r = test::run_arlequin("run " + reduced_case + sets + " --set output.dir=" + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return r.exit_code == 0 ? test::read_csv(out / "series.csv") : std::vector<std::map<std::string, std::string>>{};
+}
+
 // No breakage (failure_strain 0): the total energy stays within 1e-4 of the impact energy over
 // the 40 us (measured 4.8e-5), the sphere is stopped and sent back (the fabric holds it), and
 // the starting total is the sphere's 1/2 m v^2 (plus the yarns' contact energy at rest, below
 // 1e-5 of it: the builder's overlap tolerance).
 TEST(Fabric, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
-  const auto out = test::scratch_dir("fabric_reduced_unbreakable");
-  const auto r = test::run_arlequin("run " + reduced_case + " --set dem.sample.yarn.failure_strain=0 --set output.dir=" + out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto rows = test::read_csv(out / "series.csv");
+  std::filesystem::path out;
+  const auto rows = run_reduced("fabric_reduced_unbreakable", " --set dem.sample.yarn.failure_strain=0", out);
+  ASSERT_FALSE(rows.empty());
   const double E0 = impact_energy();
   EXPECT_NEAR(at(rows.front(), "E_total") / E0, 1.0, 1e-5);
   EXPECT_LT(worst_balance(rows), 1e-4 * E0);
@@ -51,10 +62,9 @@ TEST(Fabric, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
 // balance within 2e-3 of the impact energy (measured 1.1e-3; the bound is 1 %), and the
 // summary gives the first break's time, which the breaks file's first row repeats.
 TEST(Fabric, ReducedImpactBreakageIsClosedByTheFractureEnergy) {
-  const auto out = test::scratch_dir("fabric_reduced_breakable");
-  const auto r = test::run_arlequin("run " + reduced_case + " --set output.dir=" + out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto rows = test::read_csv(out / "series.csv");
+  std::filesystem::path out;
+  const auto rows = run_reduced("fabric_reduced_breakable", "", out);
+  ASSERT_FALSE(rows.empty());
   const double E0 = impact_energy();
   EXPECT_LT(worst_balance(rows), 2e-3 * E0);
   EXPECT_GT(at(rows.back(), "E_fracture"), 0.01 * E0);
@@ -67,6 +77,52 @@ TEST(Fabric, ReducedImpactBreakageIsClosedByTheFractureEnergy) {
   EXPECT_LT(first, 4e-5);
   // A broken spring stretched to the failure strain.
   EXPECT_GE(at(breaks.front(), "stress"), 0.035);
+}
+
+// One dataset of an HDF5 file, whole, as T (empty if it is absent, which the caller's checks
+// then report).
+template <class T>
+std::vector<T> read_all(hid_t file, const std::string& path, hid_t type) {
+  std::vector<T> values;
+  if (H5Lexists(file, path.c_str(), H5P_DEFAULT) <= 0) return values;
+  const hid_t set = H5Dopen2(file, path.c_str(), H5P_DEFAULT);
+  const hid_t space = H5Dget_space(set);
+  values.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
+  H5Sclose(space);
+  H5Dclose(set);
+  return values;
+}
+
+// The fields of the last frame (40 us, in the thick of the impact): every intact spring's
+// strain (the stretch of its line) is below the failure strain it would have broken at, and some
+// are near it (the field is the stretch, not zero); a broken one was stretched to it. Each DE's
+// `group` is its smallest group: the first weft yarn's DEs are in group 0 (`weft_0_0`, also in
+// the larger `weft` and `edges`), the sphere in its own group, the last defined.
+TEST(Fabric, FieldsGiveEachSpringsStrainAndEachDesYarn) {
+  std::filesystem::path out;
+  const auto rows = run_reduced("fabric_reduced_fields", " --set output.fields=[particles,bonds] --set output.fields_every=4e-5", out);
+  ASSERT_FALSE(rows.empty());
+  const hid_t file = H5Fopen((out / "fields.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const std::string last = "/frames/000001";  // t = 0 and t = 40 us
+  const auto strain = read_all<double>(file, last + "/bonds/cell/strain", H5T_NATIVE_DOUBLE);
+  const auto broken = read_all<std::int32_t>(file, last + "/bonds/cell/broken", H5T_NATIVE_INT32);
+  const auto group = read_all<std::int32_t>(file, last + "/particles/point/group", H5T_NATIVE_INT32);
+  H5Fclose(file);
+  ASSERT_EQ(strain.size(), broken.size());
+  ASSERT_FALSE(strain.empty());
+  double intact_max = 0.0;
+  std::size_t broken_count = 0;
+  for (std::size_t b = 0; b < strain.size(); ++b)
+    if (broken[b]) ++broken_count;
+    else intact_max = std::max(intact_max, strain[b]);
+  EXPECT_LT(intact_max, 0.035);
+  EXPECT_GT(intact_max, 0.02);
+  EXPECT_GT(broken_count, 5u);
+  ASSERT_FALSE(group.empty());
+  EXPECT_EQ(group.front(), 0);
+  EXPECT_EQ(group.back(), 3 * 5 + 2 * 5 + 4 + 3 + 1);  // 29 yarns, 3 families, edges: then the sphere
 }
 
 // cases/yarn_wave: a Kevlar yarn's front. A chain of spacing s disperses (omega = (2c/s)
