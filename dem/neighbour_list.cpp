@@ -11,11 +11,6 @@ namespace {
 constexpr std::uint64_t key_of(std::uint32_t i, std::uint32_t j) {
   return (std::uint64_t{i} << 32) | j;
 }
-// Cells are addressed by three 21-bit coordinates packed in one 64-bit key.
-constexpr std::uint64_t cell_key(std::int64_t cx, std::int64_t cy, std::int64_t cz) {
-  return (static_cast<std::uint64_t>(cx) << 42) | (static_cast<std::uint64_t>(cy) << 21) |
-         static_cast<std::uint64_t>(cz);
-}
 
 }  // namespace
 
@@ -50,18 +45,26 @@ void NeighbourList::build(const ParticleSet& p) {
     if (p.radius[i] > large) large_.push_back(static_cast<std::uint32_t>(i));
     else r_max = std::max(r_max, p.radius[i]);
   // Cell edge >= the largest interaction distance, so only the 27 surrounding cells matter;
-  // grown if needed to keep coordinates within 21 bits (very sparse scenes).
+  // grown if the box would hold more than eight cells per DE (a sparse scene), so the grid's
+  // memory stays that of the DEs.
+  const Vec3 extent = hi - lo;
   double h = 2.0 * r_max + skin_;
-  for (int k = 0; k < 3; ++k) h = std::max(h, (hi[k] - lo[k]) / 2.0e6);
-  cells_.clear();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (p.radius[i] > large) continue;
-    const Vec3& x = p.position[i];
-    cells_.push_back({cell_key(static_cast<std::int64_t>((x.x - lo.x) / h) + 1, static_cast<std::int64_t>((x.y - lo.y) / h) + 1,
-                               static_cast<std::int64_t>((x.z - lo.z) / h) + 1),
-                      static_cast<std::uint32_t>(i)});
-  }
-  std::sort(cells_.begin(), cells_.end());
+  const auto cells_along = [&](int k) { return static_cast<std::int64_t>(extent[k] / h) + 1; };
+  while (double(cells_along(0)) * double(cells_along(1)) * double(cells_along(2)) > 8.0 * double(n) + 1024.0) h *= 1.25;
+  const std::int64_t nx = cells_along(0), ny = cells_along(1), nz = cells_along(2);
+  const auto cell_of = [&](const Vec3& x) {
+    const auto c = [&](int k, std::int64_t count) { return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1); };
+    return (c(0, nx) * ny + c(1, ny)) * nz + c(2, nz);
+  };
+  // The DEs by cell (a counting sort; within a cell, by index).
+  cell_start_.assign(static_cast<std::size_t>(nx * ny * nz) + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (p.radius[i] <= large) ++cell_start_[static_cast<std::size_t>(cell_of(p.position[i])) + 1];
+  for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
+  cell_des_.resize(cell_start_.back());
+  scratch_next_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < n; ++i)
+    if (p.radius[i] <= large) cell_des_[scratch_next_[static_cast<std::size_t>(cell_of(p.position[i]))]++] = static_cast<std::uint32_t>(i);
   const auto consider = [&](std::uint32_t i, std::uint32_t j) {
     const double reach = p.radius[i] + p.radius[j] + skin_;
     if (norm2(p.position[j] - p.position[i]) >= reach * reach) return;
@@ -72,24 +75,26 @@ void NeighbourList::build(const ParticleSet& p) {
   for (std::size_t a = 0; a < large_.size(); ++a)
     for (std::uint32_t j = 0; j < n; ++j)
       if (p.radius[j] <= large || j > large_[a]) consider(large_[a], j);
-  constexpr std::uint64_t mask = (std::uint64_t{1} << 21) - 1;
-  for (std::size_t a = 0; a < cells_.size(); ++a) {
-    const auto [key, i] = cells_[a];
-    const std::int64_t cx = key >> 42, cy = (key >> 21) & mask, cz = key & mask;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const std::uint64_t other = cell_key(cx + dx, cy + dy, cz + dz);
-          if (other < key) continue;  // each cell pair once (own cell handled below)
-          auto it = std::lower_bound(cells_.begin(), cells_.end(),
-                                     std::pair<std::uint64_t, std::uint32_t>{other, 0});
-          for (; it != cells_.end() && it->first == other; ++it) {
-            const std::uint32_t j = it->second;
-            if (other == key && j <= i) continue;
-            consider(i, j);
-          }
-        }
-  }
+  // Each cell against itself and the neighbours after it in cell order: every pair of cells once.
+  for (std::int64_t cx = 0; cx < nx; ++cx)
+    for (std::int64_t cy = 0; cy < ny; ++cy)
+      for (std::int64_t cz = 0; cz < nz; ++cz) {
+        const std::int64_t c = (cx * ny + cy) * nz + cz;
+        const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
+        const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
+        for (const std::uint32_t* a = begin; a != end; ++a)
+          for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b);
+        for (std::int64_t dx = -1; dx <= 1; ++dx)
+          for (std::int64_t dy = -1; dy <= 1; ++dy)
+            for (std::int64_t dz = -1; dz <= 1; ++dz) {
+              const std::int64_t ox = cx + dx, oy = cy + dy, oz = cz + dz;
+              if (ox < 0 || oy < 0 || oz < 0 || ox >= nx || oy >= ny || oz >= nz) continue;
+              const std::int64_t other = (ox * ny + oy) * nz + oz;
+              if (other <= c) continue;
+              for (const std::uint32_t* a = begin; a != end; ++a)
+                for (std::uint32_t k = cell_start_[other]; k < cell_start_[other + 1]; ++k) consider(*a, cell_des_[k]);
+            }
+      }
   std::sort(pairs_.begin(), pairs_.end());
 }
 
