@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/error.hpp"
+
 namespace arlequin::dem {
 namespace {
 
@@ -48,10 +50,15 @@ void NeighbourList::build(const ParticleSet& p) {
   // grown if the box would hold more than eight cells per DE (a sparse scene), so the grid's
   // memory stays that of the DEs.
   const Vec3 extent = hi - lo;
-  double h = 2.0 * r_max + skin_;
-  const auto cells_along = [&](int k) { return static_cast<std::int64_t>(extent[k] / h) + 1; };
-  while (double(cells_along(0)) * double(cells_along(1)) * double(cells_along(2)) > 8.0 * double(n) + 1024.0) h *= 1.25;
-  const std::int64_t nx = cells_along(0), ny = cells_along(1), nz = cells_along(2);
+  const double largest = std::max({extent.x, extent.y, extent.z});
+  if (!std::isfinite(largest))
+    throw RunError("contact search: the DEs lie farther apart than a double can measure (beyond 1e308 m); nothing can be binned");
+  const double cap = 8.0 * double(n) + 1024.0;
+  double h = std::max(2.0 * r_max + skin_, largest / cap);  // no axis beyond the cap: counts stay small
+  const auto cells_along = [&](int k) { return std::floor(extent[k] / h) + 1.0; };
+  while (cells_along(0) * cells_along(1) * cells_along(2) > cap) h *= 1.25;
+  const auto nx = static_cast<std::int64_t>(cells_along(0)), ny = static_cast<std::int64_t>(cells_along(1)),
+             nz = static_cast<std::int64_t>(cells_along(2));
   const auto cell_of = [&](const Vec3& x) {
     const auto c = [&](int k, std::int64_t count) { return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1); };
     return (c(0, nx) * ny + c(1, ny)) * nz + c(2, nz);

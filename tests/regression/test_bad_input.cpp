@@ -212,7 +212,8 @@ TEST(BadInput, MalformedMeshIsAOneLineErrorNamingTheFile) {
 // std::out_of_range), refused naming the group and the node. particle_table/: tables of fuzz/fuzz_particle_table.cpp's
 // case (large_de_bonded_to_all.csv: DEs of 10 m among DEs of 1 mm, bonded to all of them, ended
 // in "internal error: bond colouring: more than 64 colours"; now coloured, then refused for its
-// coincident DEs).
+// coincident DEs; de_far_beyond_the_others.csv: a DE 2e34 m from the rest overflowed the
+// contact grid's cell count, undefined behaviour; now binned in cells grown to fit, and accepted).
 TEST(BadInput, EveryInputTheFuzzersCrashedOnIsRefusedInOneLine) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -238,8 +239,10 @@ TEST(BadInput, EveryInputTheFuzzersCrashedOnIsRefusedInOneLine) {
     ++inputs;
     std::filesystem::copy_file(entry.path(), dir / "table.csv", std::filesystem::copy_options::overwrite_existing);
     const auto r = test::run_arlequin("check " + (dir / "case.yaml").string());
-    EXPECT_EQ(r.exit_code, 2) << entry.path() << ": " << r.output;
-    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 2) << entry.path() << ": " << r.output;
+    if (r.exit_code == 2) {
+      EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    }
     EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
   }
   EXPECT_GE(inputs, 2);

@@ -308,6 +308,22 @@ TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
   EXPECT_NE(std::find(expected.begin(), expected.end(), std::pair{n - 2, n - 1}), expected.end());
 }
 
+// A DE 2e34 m from the others (a fuzzer's table) made the grid's cell count overflow: the cells
+// grow to fit and the pairs are still exact; DEs farther apart than a double measures are a
+// RunError, not undefined behaviour.
+TEST(NeighbourList, AFarAwayDeGrowsTheCellsAndBeyondMeasureIsARunError) {
+  ParticleSet p;
+  for (int k = 0; k < 4; ++k) p.add({0.0019 * k, 0, 0}, 1e-3, 1000.0);
+  p.add({0.003, 2.2e34, 0.0035}, 1e-3, 1000.0);
+  NeighbourList list(1e-4);
+  list.build(p);
+  const auto pairs = list.pairs();
+  EXPECT_EQ(std::vector(pairs.begin(), pairs.end()), (std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 1}, {1, 2}, {2, 3}}));
+  p.position[4].y = 1e308;
+  p.position[0].y = -1e308;
+  EXPECT_THROW(list.build(p), RunError);
+}
+
 TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
   model.finalize();
   EXPECT_LE(model.critical_time_step(), 2.0 / omega_axial);
