@@ -36,6 +36,15 @@ inline int max_threads() {
 #endif
 }
 
+// The calling thread's number in its OpenMP team (0 outside a parallel region or without OpenMP).
+inline int thread_index() {
+#ifdef _OPENMP
+  return omp_get_thread_num();
+#else
+  return 0;
+#endif
+}
+
 // Whether a loop asked to run `threaded` does run on more than one thread.
 inline bool runs_threaded(bool threaded) {
   return threaded && max_threads() > 1;

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 namespace arlequin::dem {
 namespace {
@@ -72,36 +73,45 @@ void NeighbourList::build(const ParticleSet& p) {
   scratch_next_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     if (p.radius[i] <= large) cell_des_[scratch_next_[static_cast<std::size_t>(cell_of(p.position[i]))]++] = static_cast<std::uint32_t>(i);
-  const auto consider = [&](std::uint32_t i, std::uint32_t j) {
+  const auto consider = [&](std::uint32_t i, std::uint32_t j, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
     const double reach = p.radius[i] + p.radius[j] + skin_;
     if (norm2(p.position[j] - p.position[i]) >= reach * reach) return;
     const std::uint32_t lo_id = std::min(i, j), hi_id = std::max(i, j);
     if (std::binary_search(excluded_.begin(), excluded_.end(), key_of(lo_id, hi_id))) return;
-    pairs_.emplace_back(lo_id, hi_id);
+    out.emplace_back(lo_id, hi_id);
   };
   for (std::size_t a = 0; a < large_.size(); ++a)
     for (std::uint32_t j = 0; j < n; ++j)
-      if (p.radius[j] <= large || j > large_[a]) consider(large_[a], j);
-  // Each cell against itself and the neighbours after it in cell order: every pair of cells once.
-  for (std::int64_t cx = 0; cx < nx; ++cx)
-    for (std::int64_t cy = 0; cy < ny; ++cy)
-      for (std::int64_t cz = 0; cz < nz; ++cz) {
-        const std::int64_t c = (cx * ny + cy) * nz + cz;
-        const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
-        const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
-        for (const std::uint32_t* a = begin; a != end; ++a)
-          for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b);
-        for (std::int64_t dx = -1; dx <= 1; ++dx)
-          for (std::int64_t dy = -1; dy <= 1; ++dy)
-            for (std::int64_t dz = -1; dz <= 1; ++dz) {
-              const std::int64_t ox = cx + dx, oy = cy + dy, oz = cz + dz;
-              if (ox < 0 || oy < 0 || oz < 0 || ox >= nx || oy >= ny || oz >= nz) continue;
-              const std::int64_t other = (ox * ny + oy) * nz + oz;
-              if (other <= c) continue;
-              for (const std::uint32_t* a = begin; a != end; ++a)
-                for (std::uint32_t k = cell_start_[other]; k < cell_start_[other + 1]; ++k) consider(*a, cell_des_[k]);
-            }
-      }
+      if (p.radius[j] <= large || j > large_[a]) consider(large_[a], j, pairs_);
+  // Each cell against itself and the neighbours after it in cell order: every pair of cells
+  // once. On threads each collects its own pairs; the sort below makes the list the same
+  // whatever thread found a pair.
+  const std::int64_t cells = nx * ny * nz;
+  const bool threaded = static_cast<long>(n) > parallel_threshold;
+  found_.resize(std::max<std::size_t>(found_.size(), static_cast<std::size_t>(runs_threaded(threaded) ? max_threads() : 1)));
+  for (auto& list : found_) list.clear();
+  run_threaded_if(threaded, [&] {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>& out = found_[static_cast<std::size_t>(thread_index())];
+#pragma omp for schedule(dynamic, 256)
+    for (std::int64_t c = 0; c < cells; ++c) {
+      const std::int64_t cx = c / (ny * nz), cy = c / nz % ny, cz = c % nz;
+      const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
+      const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
+      for (const std::uint32_t* a = begin; a != end; ++a)
+        for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b, out);
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy)
+          for (std::int64_t dz = -1; dz <= 1; ++dz) {
+            const std::int64_t ox = cx + dx, oy = cy + dy, oz = cz + dz;
+            if (ox < 0 || oy < 0 || oz < 0 || ox >= nx || oy >= ny || oz >= nz) continue;
+            const std::int64_t other = (ox * ny + oy) * nz + oz;
+            if (other <= c) continue;
+            for (const std::uint32_t* a = begin; a != end; ++a)
+              for (std::uint32_t k = cell_start_[other]; k < cell_start_[other + 1]; ++k) consider(*a, cell_des_[k], out);
+          }
+    }
+  });
+  for (const auto& list : found_) pairs_.insert(pairs_.end(), list.begin(), list.end());
   std::sort(pairs_.begin(), pairs_.end());
 }
 

@@ -46,6 +46,7 @@ class NeighbourList {
   std::vector<std::uint32_t> cell_start_;  // build's grid: per cell, where its DEs begin in cell_des_
   std::vector<std::uint32_t> cell_des_;    // the binned DEs, by cell, then index
   std::vector<std::uint32_t> scratch_next_;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // build's pairs, per thread
   std::vector<std::uint32_t> large_;   // DEs kept out of the cells (build's scratch)
   std::vector<double> scratch_radius_;  // build's scratch, for the median radius
   std::size_t builds_ = 0;

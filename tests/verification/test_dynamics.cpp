@@ -8,8 +8,10 @@
 #include <random>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "dem/contacts/penalty_contact.hpp"
 #include "support/dem_fixtures.hpp"
+#include "support/omp_threads.hpp"
 
 namespace arlequin::dem {
 namespace {
@@ -279,19 +281,18 @@ TEST(PenaltyContact, FrictionOpposesSlidingWithTheCoulombForce) {
 // The neighbour list keeps a DE far larger than the median (an impactor) out of its cells and
 // tests it against every DE: the pairs are those of a brute-force search over all pairs
 // (within R_i + R_j + skin, excluded pairs left out), with the impactor among small DEs, a
-// second impactor near it, and small DEs at a distance from both.
+// second impactor near it, and small DEs at a distance from both; built on one and on two
+// threads (above the threshold, each thread collecting the pairs of its cells).
 TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
   ParticleSet p;
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const double r = 1e-4, skin = 3e-5;
-  for (int k = 0; k < 1500; ++k) p.add({u(rng) * 8e-3, u(rng) * 8e-3, u(rng) * 2e-3}, r * (0.9 + 0.2 * u(rng)), 1000.0);
+  static_assert(6000 > parallel_threshold);
+  for (int k = 0; k < 6000; ++k) p.add({u(rng) * 8e-3, u(rng) * 8e-3, u(rng) * 2e-3}, r * (0.9 + 0.2 * u(rng)), 1000.0);
   p.add({4e-3, 4e-3, 2.5e-3}, 2e-3, 7530.0);   // the impactor, touching the bed
   p.add({4e-3, 7e-3, 3.3e-3}, 1.5e-3, 7530.0);  // another, touching the first and the bed
   const std::uint32_t n = static_cast<std::uint32_t>(p.size());
-  NeighbourList list(skin);
-  list.set_exclusions({{3, 4}, {n - 2, 17}});
-  list.build(p);
   std::vector<std::pair<std::uint32_t, std::uint32_t>> expected;
   for (std::uint32_t i = 0; i < n; ++i)
     for (std::uint32_t j = i + 1; j < n; ++j) {
@@ -299,8 +300,16 @@ TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
       const double reach = p.radius[i] + p.radius[j] + skin;
       if (norm2(p.position[j] - p.position[i]) < reach * reach) expected.emplace_back(i, j);
     }
-  const auto pairs = list.pairs();
-  EXPECT_EQ(std::vector(pairs.begin(), pairs.end()), expected);
+  for (const int threads : {1, 2}) {
+#ifdef _OPENMP
+    const test::OmpThreads scope(threads);
+#endif
+    NeighbourList list(skin);
+    list.set_exclusions({{3, 4}, {n - 2, 17}});
+    list.build(p);
+    const auto pairs = list.pairs();
+    EXPECT_EQ(std::vector(pairs.begin(), pairs.end()), expected) << threads << " thread(s)";
+  }
   // The case is the one it is meant to be: both large DEs have many neighbours, and meet.
   const auto with = [&](std::uint32_t d) { return std::count_if(expected.begin(), expected.end(), [&](auto q) { return q.first == d || q.second == d; }); };
   EXPECT_GT(with(n - 2), 50);
