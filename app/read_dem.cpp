@@ -319,9 +319,9 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     const Vec3 x = item.vec3("position", Range::any(), "m");
     if (scene.continuum && !scene.continuum->in_dem_domain(x))
       item.fail("position", "this DE lies beyond the coupling overlap, in the pure-continuum zone");
+    const double r = item.number("radius", Range::positive(), "m");
     // An impactor that starts inside a fabric would be shot out by the contact at once.
     if (scene.weave) {
-      const double r = item.number("radius", Range::positive(), "m");
       for (std::size_t j = 0; j < built; ++j)
         if (norm(p.position[j] - x) < r + p.radius[j]) {
           char where[160];
@@ -332,7 +332,7 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     }
     const double own = item.has("density") ? item.number("density", Range::positive(), "kg/m^3") : density;
     if (std::isnan(own)) item.fail("density", "expected this DE's density (there is no dem.density to fall back on)");
-    const std::size_t i = p.add(x, item.number("radius", Range::positive(), "m"), own);
+    const std::size_t i = p.add(x, r, own);
     p.velocity[i] = item.vec3_or("velocity", {}, Range::any(), "m/s");
     item.finish();
   }

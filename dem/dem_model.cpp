@@ -429,7 +429,7 @@ void DemModel::apply_loads_and_damping() {
     const long n = static_cast<long>(p.size());
     for_each_index(n, n > parallel_threshold, [&](long i) {
       for (int k = 0; k < 3; ++k)
-        if (!(driven_[i] & (1 << k))) p.force[i][k] += p.mass(i) * gravity_[k];
+        if (!imposes(i, k)) p.force[i][k] += p.mass(i) * gravity_[k];
     });
   }
   if (damping_ > 0.0) {
@@ -439,7 +439,7 @@ void DemModel::apply_loads_and_damping() {
     for_each_index(n, n > parallel_threshold, [&](long i) {
       damping_force_[i] = p.velocity[i] * (-damping_ * p.mass(i));
       for (int k = 0; k < 3; ++k)
-        if (driven_[i] & (1 << k)) damping_force_[i][k] = 0.0;
+        if (imposes(i, k)) damping_force_[i][k] = 0.0;
       damping_torque_[i] = (driven_[i] & 8) ? Vec3{} : p.angular_velocity[i] * (-damping_ * p.inertia(i));
       p.force[i] += damping_force_[i];
       p.torque[i] += damping_torque_[i];
@@ -486,7 +486,7 @@ Energies DemModel::energies() const {
   if (gravity_ != Vec3{})
     for (std::size_t i = 0; i < particles.size(); ++i)
       for (int k = 0; k < 3; ++k)
-        if (!(driven_[i] & (1 << k)))
+        if (!imposes(i, k))
           e.external_work += particles.mass(i) * gravity_[k] * (particles.position[i][k] - particles.reference[i][k]);
   e.dissipated = dissipated_;
   e.fracture = fracture_;

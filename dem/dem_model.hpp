@@ -222,6 +222,8 @@ class DemModel {
     std::vector<int> bonds;
   } phase_{};
   std::vector<std::uint8_t> driven_;  // per DE: bits 0-2 imposed x, y, z; bit 3 rotation locked
+  // Whether a kinematic condition imposes component k (0-2) of DE i's motion.
+  bool imposes(std::size_t i, int k) const { return driven_[i] & (1u << k); }
   double time_ = 0.0;
   double last_dt_ = 0.0;  // s, step size of the step in progress (0 before the first)
   long steps_ = 0;

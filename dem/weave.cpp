@@ -299,13 +299,12 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
   }
   model.add_group("edges", std::move(edges));
 
-  for (const Yarn& y : yarns) {
-    int& count = y.family == 0 ? report.wefts : y.family == 1 ? report.stuffers : report.binders;
-    ++count;
-    (y.family == 0 ? report.weft_length : y.family == 1 ? report.stuffer_length : report.binder_length) = y.length;
-  }
   double total_length = 0.0;
-  for (const Yarn& y : yarns) total_length += y.length;
+  for (const Yarn& y : yarns) {
+    ++(y.family == 0 ? report.wefts : y.family == 1 ? report.stuffers : report.binders);
+    (y.family == 0 ? report.weft_length : y.family == 1 ? report.stuffer_length : report.binder_length) = y.length;
+    total_length += y.length;
+  }
   report.thickness = 2.0 * A + s.yarn_thickness;
   report.areal_density = report.mass / (s.length_x * s.length_y);
   report.fibre_volume_fraction = s.section * total_length / (s.length_x * s.length_y * report.thickness);

@@ -9,10 +9,9 @@
 #include <cmath>
 #include <numbers>
 
-#include <hdf5.h>
-
 #include "common/json.hpp"
 #include "support/cli.hpp"
+#include "support/hdf5_read.hpp"
 
 namespace arlequin {
 namespace {
@@ -79,21 +78,6 @@ TEST(Fabric, ReducedImpactBreakageIsClosedByTheFractureEnergy) {
   EXPECT_GE(at(breaks.front(), "stress"), 0.035);
 }
 
-// One dataset of an HDF5 file, whole, as T (empty if it is absent, which the caller's checks
-// then report).
-template <class T>
-std::vector<T> read_all(hid_t file, const std::string& path, hid_t type) {
-  std::vector<T> values;
-  if (H5Lexists(file, path.c_str(), H5P_DEFAULT) <= 0) return values;
-  const hid_t set = H5Dopen2(file, path.c_str(), H5P_DEFAULT);
-  const hid_t space = H5Dget_space(set);
-  values.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
-  H5Dread(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
-  H5Sclose(space);
-  H5Dclose(set);
-  return values;
-}
-
 // The fields of the last frame (40 us, in the thick of the impact): every intact spring's
 // strain (the stretch of its line) is below the failure strain it would have broken at, and some
 // are near it (the field is the stretch, not zero); a broken one was stretched to it. Each DE's
@@ -106,9 +90,9 @@ TEST(Fabric, FieldsGiveEachSpringsStrainAndEachDesYarn) {
   const hid_t file = H5Fopen((out / "fields.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(file, 0);
   const std::string last = "/frames/000001";  // t = 0 and t = 40 us
-  const auto strain = read_all<double>(file, last + "/bonds/cell/strain", H5T_NATIVE_DOUBLE);
-  const auto broken = read_all<std::int32_t>(file, last + "/bonds/cell/broken", H5T_NATIVE_INT32);
-  const auto group = read_all<std::int32_t>(file, last + "/particles/point/group", H5T_NATIVE_INT32);
+  const auto strain = test::read_dataset<double>(file, last + "/bonds/cell/strain", H5T_NATIVE_DOUBLE);
+  const auto broken = test::read_dataset<std::int32_t>(file, last + "/bonds/cell/broken", H5T_NATIVE_INT32);
+  const auto group = test::read_dataset<std::int32_t>(file, last + "/particles/point/group", H5T_NATIVE_INT32);
   H5Fclose(file);
   ASSERT_EQ(strain.size(), broken.size());
   ASSERT_FALSE(strain.empty());

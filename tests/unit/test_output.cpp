@@ -2,6 +2,7 @@
 // Output writers: atomic files, CSV series, JSON summaries and HDF5/XDMF fields.
 #include <gtest/gtest.h>
 
+#include "support/hdf5_read.hpp"
 #include "support/scratch_dir.hpp"
 #include <unistd.h>
 #include <hdf5.h>
@@ -125,20 +126,7 @@ TEST_F(OutputTest, JsonFilesKeepOrderWriteNullForNonFiniteAndNameABadFile) {
   EXPECT_THROW(read_json_file(dir_ / "missing.json"), InputError);
 }
 
-template <class T>
-std::vector<T> read_dataset(hid_t file, const std::string& path, hid_t type, std::vector<hsize_t> expected_dims) {
-  const hid_t dataset = H5Dopen2(file, path.c_str(), H5P_DEFAULT);
-  EXPECT_GE(dataset, 0) << path;
-  const hid_t space = H5Dget_space(dataset);
-  std::vector<hsize_t> dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)));
-  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
-  EXPECT_EQ(dims, expected_dims) << path;
-  std::vector<T> values(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
-  EXPECT_GE(H5Dread(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0) << path;
-  H5Sclose(space);
-  H5Dclose(dataset);
-  return values;
-}
+using test::read_dataset;
 
 double read_time(hid_t file, const std::string& frame) {
   double time = -1.0;
