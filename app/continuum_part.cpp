@@ -41,7 +41,7 @@ constexpr KeyDoc mesh_keys[] = {
     {"order", KeyType::integer, "", Range::between(1, 2), "1", "element order: P1 or P2 tetrahedra"},
 };
 constexpr KeyDoc material_keys[] = {
-    {"model", KeyType::choice, "", {}, "isotropic", "elastic model", "isotropic | transversely_isotropic"},
+    {"model", KeyType::choice, "", {}, "isotropic", "elastic model", "isotropic | transversely_isotropic | orthotropic"},
     {"density", KeyType::number, "kg/m^3", Range::positive(), "", "density"},
     {"E", KeyType::number, "Pa", Range::positive(), "", "isotropic: Young's modulus"},
     {"nu", KeyType::number, "1", Range::open_between(-1, 0.5), "", "isotropic: Poisson's ratio"},
@@ -51,6 +51,15 @@ constexpr KeyDoc material_keys[] = {
     {"nu_TT", KeyType::number, "1", Range::open_between(-1, 1), "", "transversely isotropic: Poisson's ratio in the transverse plane"},
     {"G_LT", KeyType::number, "Pa", Range::positive(), "", "transversely isotropic: axial shear modulus"},
     {"axis", KeyType::vec3, "1", {}, "", "transversely isotropic: the axis (normalised)"},
+    {"E_x", KeyType::number, "Pa", Range::positive(), "", "orthotropic: Young's modulus along x (likewise E_y, E_z)"},
+    {"E_y", KeyType::number, "Pa", Range::positive(), "", "orthotropic: Young's modulus along y"},
+    {"E_z", KeyType::number, "Pa", Range::positive(), "", "orthotropic: Young's modulus along z"},
+    {"G_xy", KeyType::number, "Pa", Range::positive(), "", "orthotropic: shear modulus in the x-y plane"},
+    {"G_xz", KeyType::number, "Pa", Range::positive(), "", "orthotropic: shear modulus in the x-z plane"},
+    {"G_yz", KeyType::number, "Pa", Range::positive(), "", "orthotropic: shear modulus in the y-z plane"},
+    {"nu_xy", KeyType::number, "1", Range::open_between(-1, 1), "0", "orthotropic: -eps_y / eps_x under stress along x"},
+    {"nu_xz", KeyType::number, "1", Range::open_between(-1, 1), "0", "orthotropic: -eps_z / eps_x under stress along x"},
+    {"nu_yz", KeyType::number, "1", Range::open_between(-1, 1), "0", "orthotropic: -eps_z / eps_y under stress along y"},
 };
 constexpr KeyDoc continuum_boundary_keys[] = {
     {"group", KeyType::string, "", {}, "", "a physical group of the mesh"},
@@ -109,13 +118,24 @@ constexpr SchemaSection continuum_sections[] = {
 using continuum::ContinuumSolver;
 
 continuum::Material read_material(CaseNode m) {
-  static constexpr std::string_view models[] = {"isotropic", "transversely_isotropic"};
+  static constexpr std::string_view models[] = {"isotropic", "transversely_isotropic", "orthotropic"};
   const std::string model = m.choice_or("model", "isotropic", models);
   const double density = m.number("density", Range::positive(), "kg/m^3");
   continuum::Material material;
   if (model == "isotropic") {
     material = continuum::Material::isotropic(m.number("E", Range::positive(), "Pa"),
                                               m.number("nu", Range::open_between(-1.0, 0.5), "1"), density);
+  } else if (model == "orthotropic") {
+    const auto modulus = [&m](const char* key) { return m.number(key, Range::positive(), "Pa"); };
+    const auto ratio = [&m](const char* key) { return m.number_or(key, 0.0, Range::open_between(-1.0, 1.0), "1"); };
+    const std::array<double, 3> E{modulus("E_x"), modulus("E_y"), modulus("E_z")};
+    const std::array<double, 3> G{modulus("G_yz"), modulus("G_xz"), modulus("G_xy")};
+    const std::array<double, 3> nu{ratio("nu_xy"), ratio("nu_xz"), ratio("nu_yz")};
+    try {
+      material = continuum::Material::orthotropic(E, G, nu, density);
+    } catch (const InputError& e) {
+      m.fail("model", e.what());
+    }
   } else {
     const double E_L = m.number("E_L", Range::positive(), "Pa"), E_T = m.number("E_T", Range::positive(), "Pa");
     const double nu_LT = m.number("nu_LT", Range::open_between(-1.0, 0.5), "1");

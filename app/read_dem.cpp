@@ -240,7 +240,6 @@ constexpr std::string_view builders[] = {"lattice", "chain", "particles", "packi
 
 // build: weave (dem/weave.hpp): the DEs, their springs and the groups of a 3D interlock.
 void read_weave(CaseNode& sample, Scene& scene) {
-  if (scene.continuum) sample.fail("build", "a weave cannot be coupled to a continuum yet");
   dem::WeaveSpec spec;
   const auto size = sample.numbers("size", Range::positive(), "m");
   if (size.size() != 2) sample.fail("size", "expected the fabric's extent [along x, along y]");
@@ -269,7 +268,10 @@ void read_weave(CaseNode& sample, Scene& scene) {
                            (spec.length_x / spec.weft_spacing * spec.length_y + spec.length_y / spec.warp_spacing * spec.length_x) /
                            spec.yarn_thickness * spec.chains_through);
   try {
-    scene.weave = dem::build_weave(scene.dem, spec);
+    // Coupled: the DEM patch is the weave's part in the DEM domain (its yarns end in the overlap).
+    std::function<bool(const Vec3&)> keep;
+    if (scene.continuum) keep = [&scene](const Vec3& x) { return scene.continuum->in_dem_domain(x); };
+    scene.weave = dem::build_weave(scene.dem, spec, keep);
   } catch (const dem::WeaveError& e) {
     sample.fail(e.field(), e.what());
   }
@@ -304,8 +306,11 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     const double spacing = sample.number_or("spacing", 2.0 * radius, Range::positive(), "m");
     dem::build_chain(p, start, normalized(direction), int(count), spacing, radius, density);
   }
-  // Coupled: the built DEs beyond the overlap (in the pure-continuum zone) are not created.
-  if (scene.continuum)
+  // Coupled: the built DEs beyond the overlap (in the pure-continuum zone) are not created (a
+  // weave's are not built).
+  if (scene.weave)
+    scene.des_not_created = scene.weave->des_not_kept;
+  else if (scene.continuum)
     scene.des_not_created = p.keep_only([&](std::size_t i) { return scene.continuum->in_dem_domain(p.position[i]); });
   // Explicit DEs (an impactor, a two-body test), after the built ones; the only ones for
   // build: particles.

@@ -16,6 +16,14 @@ constexpr int voigt(int i, int j) {
   return 6 - i - j;  // (1,2)->3 yz, (0,2)->4 xz, (0,1)->5 xy
 }
 
+// C = S^-1 for a compliance S that must be positive definite (InputError naming the model).
+Stiffness stiffness_of_compliance(const Stiffness& S, const char* model) {
+  Eigen::SelfAdjointEigenSolver<Stiffness> eig(S);
+  if (eig.eigenvalues().minCoeff() <= 0)
+    throw InputError(std::string(model) + " constants give a compliance that is not positive definite");
+  return S.inverse();
+}
+
 }  // namespace
 
 Material Material::isotropic(double E, double nu, double density) {
@@ -45,10 +53,7 @@ Material Material::transversely_isotropic(double E_L, double E_T, double nu_LT, 
   S(1, 2) = S(2, 1) = -nu_TT / E_T;
   S(3, 3) = 2 * (1 + nu_TT) / E_T;  // 1 / G_TT
   S(4, 4) = S(5, 5) = 1 / G_LT;
-  Eigen::SelfAdjointEigenSolver<Stiffness> eig(S);
-  if (eig.eigenvalues().minCoeff() <= 0)
-    throw InputError("transversely isotropic constants give a compliance that is not positive definite");
-  const Stiffness C_local = S.inverse();
+  const Stiffness C_local = stiffness_of_compliance(S, "transversely isotropic");
 
   // Material frame: rows of R are the local axes (e_L, e_T1, e_T2), x_local = R x.
   Eigen::Vector3d a(axis.x, axis.y, axis.z);
@@ -75,6 +80,26 @@ Material Material::transversely_isotropic(double E_L, double E_T, double nu_LT, 
                 for (int s = 0; s < 3; ++s) c += R(p, i) * R(q, j) * R(r, k) * R(s, l) * C_local(voigt(p, q), voigt(r, s));
           m.C(voigt(i, j), voigt(k, l)) = c;
         }
+  return m;
+}
+
+Material Material::orthotropic(const std::array<double, 3>& E, const std::array<double, 3>& G,
+                               const std::array<double, 3>& nu, double density) {
+  if (!(E[0] > 0 && E[1] > 0 && E[2] > 0 && G[0] > 0 && G[1] > 0 && G[2] > 0 && density > 0))
+    throw InputError("orthotropic material needs E_x, E_y, E_z, G_yz, G_xz, G_xy, density > 0");
+  // Compliance in the x, y, z axes (Jones, Mechanics of Composite Materials, Eq. 2.20), with
+  // nu_ij = -eps_j / eps_i under a stress along i, so S_ij = -nu_ij / E_i = -nu_ji / E_j.
+  Stiffness S = Stiffness::Zero();
+  for (int i = 0; i < 3; ++i) {
+    S(i, i) = 1 / E[i];
+    S(3 + i, 3 + i) = 1 / G[i];
+  }
+  S(0, 1) = S(1, 0) = -nu[0] / E[0];  // nu_xy
+  S(0, 2) = S(2, 0) = -nu[1] / E[0];  // nu_xz
+  S(1, 2) = S(2, 1) = -nu[2] / E[1];  // nu_yz
+  Material m;
+  m.density = density;
+  m.C = stiffness_of_compliance(S, "orthotropic");
   return m;
 }
 

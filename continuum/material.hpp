@@ -4,6 +4,7 @@
 // sigma = C eps and the strain energy density is eps.C.eps / 2.
 #pragma once
 #include <Eigen/Dense>
+#include <array>
 
 #include "common/vec3.hpp"
 
@@ -23,6 +24,11 @@ struct Material {
   // the compliance is positive definite.
   static Material transversely_isotropic(double E_L, double E_T, double nu_LT, double nu_TT, double G_LT,
                                          const Vec3& axis, double density);
+  // Orthotropic in the x, y, z axes: E = (E_x, E_y, E_z), G = (G_yz, G_xz, G_xy) (Voigt order),
+  // nu = (nu_xy, nu_xz, nu_yz) with nu_ij = -eps_j / eps_i under uniaxial stress along i.
+  // InputError unless the moduli and density are positive and the compliance positive definite.
+  static Material orthotropic(const std::array<double, 3>& E, const std::array<double, 3>& G,
+                              const std::array<double, 3>& nu, double density);
 };
 
 }  // namespace arlequin::continuum

@@ -143,8 +143,9 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
   if (inside.empty()) throw SettingError("overlap", "no DE lies in the overlap (" + zone.description() + ")");
   // W_p: the part of DE p's Laguerre cell (of the whole packing) inside the overlap. A DE whose
   // centre lies on the overlap's boundary brings the part of its cell on the overlap's side only.
+  // The cells are cut to the overlap's bounds first, which leaves that part as it is.
   const std::vector<double> share = dem::laguerre_cell_measures(
-      p.reference, p.radius, inside, [&zone](const Polyhedron& cell) { return zone.volume_inside(cell); });
+      p.reference, p.radius, inside, [&zone](const Polyhedron& cell) { return zone.volume_inside(cell); }, &zone.bounds());
   std::vector<Vec3> x;
   for (std::size_t k = 0; k < inside.size(); ++k)
     if (share[k] > 0.0) {  // a centre on the boundary within its tolerance, with no cell inside, has nothing to carry

@@ -9,6 +9,87 @@
 
 namespace arlequin::coupling {
 
+namespace {
+
+// x = A^-1 x for a factor of A = P^T L D L^T P, spelled out (Eigen's own solve applies the
+// inverse permutation in place, which allocates a mask each call); scratch of x's size.
+void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D,
+                       Eigen::VectorXd& x, Eigen::VectorXd& scratch) {
+  scratch = f.permutationP() * x;
+  f.matrixL().solveInPlace(scratch);
+  scratch.array() /= D.array();
+  f.matrixU().solveInPlace(scratch);
+  x = f.permutationPinv() * scratch;
+}
+
+bool is_diagonal(const SparseMatrix& G) {
+  if (G.rows() != G.cols()) return false;
+  for (int r = 0; r < G.outerSize(); ++r)
+    for (SparseMatrix::InnerIterator it(G, r); it; ++it)
+      if (it.col() != r) return false;
+  return true;
+}
+
+}  // namespace
+
+std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const Eigen::VectorXd& md,
+                                                                            const Eigen::VectorXd& mc) const {
+  const CouplingOperators& ops = *ops_;
+  if (ops.settings.mediator != Mediator::fine || ops.settings.type != CouplingType::l2 || !is_diagonal(ops.Gd)) return nullptr;
+  const int rows = ops.rows();
+  auto a = std::make_unique<LowRank>();
+  a->inv_D.resize(rows);
+  const Eigen::VectorXd g = ops.Gd.diagonal();
+  for (int r = 0; r < rows; ++r) {
+    const double d = g[r] * g[r] * md[r];
+    if (!(d > 0.0)) return nullptr;  // a driven DE: D is singular
+    a->inv_D[r] = 1.0 / d;
+  }
+  // The continuum dofs G_c reaches that can move, renumbered 0..k-1.
+  std::vector<int> reduced(static_cast<std::size_t>(ops.Gc.cols()), -1);
+  int k = 0;
+  std::vector<Eigen::Triplet<double>> t;
+  std::vector<double> masses;
+  for (int r = 0; r < rows; ++r)
+    for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it) {
+      const auto j = static_cast<std::size_t>(it.col());
+      if (mc[it.col()] == 0.0) continue;
+      if (reduced[j] < 0) {
+        reduced[j] = k++;
+        masses.push_back(1.0 / mc[it.col()]);
+      }
+      t.emplace_back(r, reduced[j], it.value());
+    }
+  a->U.resize(rows, k);
+  a->U.setFromTriplets(t.begin(), t.end());
+  Eigen::SparseMatrix<double> K = Eigen::SparseMatrix<double>(a->U.transpose()) * a->inv_D.asDiagonal() * a->U;
+  for (int j = 0; j < k; ++j) K.coeffRef(j, j) += masses[static_cast<std::size_t>(j)];
+  a->K = std::make_unique<Factor>();
+  a->K->compute(K);
+  if (a->K->info() != Eigen::Success || !(a->K->vectorD().minCoeff() > 0.0)) return nullptr;
+  a->K_diagonal = a->K->vectorD();
+  // The set-up check: A y = r to 1e-10 for y solved from a fixed r (A applied matrix-free).
+  Eigen::VectorXd r(rows), y(rows);
+  for (int i = 0; i < rows; ++i) r[i] = 1.0 + 0.5 * std::sin(1.0 + i);
+  y = r;
+  solve_low_rank(*a, y);
+  Eigen::VectorXd Ay = y.cwiseQuotient(a->inv_D);
+  const Eigen::VectorXd Uty = Eigen::SparseMatrix<double>(a->U.transpose()) * y;
+  Eigen::VectorXd CUty(k);
+  for (int j = 0; j < k; ++j) CUty[j] = Uty[j] / masses[static_cast<std::size_t>(j)];
+  Ay += a->U * CUty;
+  if (!((Ay - r).norm() <= 1e-10 * r.norm())) return nullptr;
+  return a;
+}
+
+void MultiplierSolver::solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const {
+  column.array() *= a.inv_D.array();                 // y = D^-1 r
+  reduced_.noalias() = a.U.transpose() * column;     // U^T y
+  solve_with_factor(*a.K, a.K_diagonal, reduced_, reduced_scratch_);
+  solution_.noalias() = a.U * reduced_;              // U K^-1 U^T y
+  column.array() -= a.inv_D.array() * solution_.array();
+}
+
 MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
                                    const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc)
     : ops_(&ops) {
@@ -19,6 +100,27 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
   for (int p = 0; p < np; ++p) inv_d_.row(p).setConstant(inv_mass_d[p]);
   inv_c_ = Eigen::Map<const Matrix3>(inv_mass_c.data(), nn, 3);
 
+  // The low-rank form when every distinct component has it; else the general factor.
+  if (!petsc) {
+    for (int c = 0; c < 3; ++c) {
+      int same = -1;
+      for (int b = 0; b < c && same < 0; ++b)
+        if (inv_c_.col(b) == inv_c_.col(c)) same = factor_of_[b];
+      if (same >= 0) {
+        factor_of_[c] = same;
+        continue;
+      }
+      auto a = low_rank_form(inv_d_.col(c), inv_c_.col(c));
+      if (!a) {
+        low_rank_.clear();
+        break;
+      }
+      factor_of_[c] = static_cast<int>(low_rank_.size());
+      nonzeros_ = a->U.nonZeros();
+      low_rank_.push_back(std::move(a));
+    }
+    if (!low_rank_.empty()) return;
+  }
   for (int c = 0; c < 3; ++c) {
     int same = -1;
     for (int b = 0; b < c && same < 0; ++b)
@@ -78,6 +180,12 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
   lambda.resize(rhs.rows(), 3);
   for (int c = 0; c < 3; ++c) {
     const int k = factor_of_[c];
+    if (!low_rank_.empty()) {
+      column_ = rhs.col(c);
+      solve_low_rank(*low_rank_[k], column_);
+      lambda.col(c) = column_;
+      continue;
+    }
     column_ = rhs.col(c).cwiseProduct(scales_[k]);
     if (!petsc_.empty()) {
       // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
@@ -88,17 +196,15 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
       lambda.col(c) = solution_.cwiseProduct(scales_[k]);
       continue;
     }
-    const Factor& f = *factors_[k];
-    solution_ = f.permutationP() * column_;
-    f.matrixL().solveInPlace(solution_);
-    solution_.array() /= diagonals_[k].array();
-    f.matrixU().solveInPlace(solution_);
-    column_ = f.permutationPinv() * solution_;
+    solve_with_factor(*factors_[k], diagonals_[k], column_, solution_);
     lambda.col(c) = column_.cwiseProduct(scales_[k]);
   }
 }
 
-std::string MultiplierSolver::backend() const { return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description(); }
+std::string MultiplierSolver::backend() const {
+  if (!low_rank_.empty()) return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_.front()->U.cols()) + " continuum dofs";
+  return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description();
+}
 
 void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const {
   out.noalias() = ops_->Gd * vd;

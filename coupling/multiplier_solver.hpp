@@ -20,6 +20,18 @@
 //    coupled model, not shared between threads).
 //  - RunError if A is not positive definite (e.g. a coarse mediator with too few DEs per
 //    element to fix every mediator node; the message suggests the fine mediator).
+//  - With the fine mediator and L2 coupling G_d = W is diagonal and G_c = -W N, so
+//    A = D + U C U^T with D = W M_d^-1 W diagonal (positive while no coupled DE is driven),
+//    U = G_c restricted to the continuum dofs it reaches with a non-zero inverse mass, C their
+//    inverse masses. Then A, whose LDL^T fills in wherever two DEs share an element (rows of
+//    thousands of entries for a yarn-dense overlap), is solved exactly by the
+//    Sherman-Morrison-Woodbury identity (Golub & Van Loan, Matrix Computations, 4th ed.,
+//    section 2.1.4): A^-1 r = D^-1 r - D^-1 U K^-1 U^T D^-1 r with K = C^-1 + U^T D^-1 U, a
+//    matrix over those continuum nodes only, SPD, factored once (LDL^T). A step then costs
+//    O(non-zeros of N). The subtraction is benign when the continuum's nodes outweigh the DEs
+//    they carry (C small against D^-1's scale: the case of a coupling); it is checked at set-up
+//    on a residual of A, matrix-free, and the general LDL^T above is used when the check fails
+//    (or with PETSc, or with H1 coupling, whose S is not diagonal). backend() says which.
 //  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
 //    the same Jacobi-scaled A, with the case's options: PETSc's way of choosing a solver at run
 //    time, e.g. an iterative one for a large overlap; the application's default, preonly +
@@ -58,7 +70,7 @@ class MultiplierSolver {
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
   // Distinct systems (one per distinct column of inverse masses; the others reuse one).
-  int systems() const { return static_cast<int>(scales_.size()); }
+  int systems() const { return static_cast<int>(low_rank_.empty() ? scales_.size() : low_rank_.size()); }
   // "LDL^T" or "PETSc <ksp> + <pc>".
   std::string backend() const;
   int rows() const { return ops_->rows(); }
@@ -66,7 +78,20 @@ class MultiplierSolver {
 
  private:
   using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
+  // The Woodbury form of one component's A (above).
+  struct LowRank {
+    Eigen::VectorXd inv_D;            // per row
+    Eigen::SparseMatrix<double> U;    // rows x reached dofs of the component
+    std::unique_ptr<Factor> K;
+    Eigen::VectorXd K_diagonal;
+  };
+  // The low-rank form of A for inverse masses (md, mc), or nullptr when it does not apply or its
+  // set-up residual check fails.
+  std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc) const;
+  void solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const;
+
   const CouplingOperators* ops_;
+  std::vector<std::unique_ptr<LowRank>> low_rank_;  // one per system, or empty
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
   std::vector<std::unique_ptr<Factor>> factors_;  // our LDL^T, or
   std::vector<std::unique_ptr<PetscSpdSolver>> petsc_;  // PETSc's solve
@@ -76,6 +101,7 @@ class MultiplierSolver {
   long nonzeros_ = 0;
   mutable Matrix3 rhs_;                        // scratch: the residual to project
   mutable Eigen::VectorXd column_, solution_;  // scratch: one component
+  mutable Eigen::VectorXd reduced_, reduced_scratch_;  // scratch: the low-rank form's K solve
 };
 
 }  // namespace arlequin::coupling

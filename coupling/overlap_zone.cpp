@@ -111,7 +111,7 @@ OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Wei
   std::ostringstream d;
   d << "box " << vec(b.lower) << "-" << vec(b.upper) << ", ramp along axis " << axis << " with the DEM on the "
     << (dem_on_lower_side ? "lower" : "upper") << " side";
-  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), {box_planes(b), {}},
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), {box_planes(b), {}, b},
                      weighting, d.str());
 }
 
@@ -135,6 +135,9 @@ OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting
     const Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
     shape.solid.push_back({n, dot(n, base) + c.radius});
   }
+  const Vec3 top = base + length * axis, margin{c.radius, c.radius, c.radius};
+  for (int k = 0; k < 3; ++k)
+    shape.bounds.lower[k] = std::min(base[k], top[k]) - margin[k], shape.bounds.upper[k] = std::max(base[k], top[k]) + margin[k];
   const Region region{c};
   std::ostringstream d;
   d << "cylinder base " << vec(base) << " axis " << vec(axis) << " radius " << c.radius << " length " << length
@@ -166,7 +169,7 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
   std::ostringstream d;
   d << "shell between box " << vec(inner.lower) << "-" << vec(inner.upper) << " (DEM inside) and box "
     << vec(outer.lower) << "-" << vec(outer.upper);
-  return OverlapZone(std::move(contains), std::move(ramp), {box_planes(outer), box_planes(inner)}, weighting, d.str());
+  return OverlapZone(std::move(contains), std::move(ramp), {box_planes(outer), box_planes(inner), outer}, weighting, d.str());
 }
 
 }  // namespace arlequin::coupling

@@ -75,6 +75,8 @@ class OverlapZone {
   const Weighting& weighting() const { return weighting_; }
   const std::string& description() const { return description_; }
   double volume_inside(const Polyhedron& cell) const;
+  // A box that contains the overlap (for a cylinder, not the tightest).
+  const Box& bounds() const { return shape_.bounds; }
 
   static constexpr int kCylinderSides = 128;
 
@@ -86,6 +88,7 @@ class OverlapZone {
   // The overlap = intersection of `solid` minus the intersection of `hole` (empty: no hole).
   struct Polyhedral {
     std::vector<Plane> solid, hole;
+    Box bounds;  // contains solid
   };
   OverlapZone(Membership contains, RampCoordinate ramp, Polyhedral shape, Weighting weighting, std::string description);
   static std::vector<Plane> box_planes(const Box& box);

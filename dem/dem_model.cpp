@@ -128,7 +128,8 @@ void DemModel::finalize() {
     bond_frequency_bound_.assign(n, 0.0);
     std::vector<double> rot(n, 0.0);
     for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, bond_frequency_bound_, rot);
-    inv_mass_max_ = n > 0 ? *std::max_element(particles.inv_mass.begin(), particles.inv_mass.end()) : 0.0;
+    inv_mass_max_ = 0.0;
+    for (std::size_t i = 0; i < n; ++i) inv_mass_max_ = std::max(inv_mass_max_, contact_inv_mass(i));
     touching_.assign(n, 0);
   }
   if (rdef_) rdef_->prepare(particles, group_members_);
@@ -139,8 +140,12 @@ void DemModel::finalize() {
   apply_loads_and_damping();
 }
 
+double DemModel::contact_inv_mass(std::size_t i) const {
+  return contact_weight_.empty() ? particles.inv_mass[i] : contact_weight_[i] * particles.inv_mass[i];
+}
+
 double DemModel::contact_frequency_bound(std::size_t i, std::uint32_t contacts) const {
-  const double inv_m = particles.inv_mass[i];
+  const double inv_m = contact_inv_mass(i);
   return contact_->stiffness() * contacts * (inv_m + std::sqrt(inv_m * inv_mass_max_));
 }
 
@@ -245,7 +250,11 @@ void DemModel::finish_step(double dt) {
 
 void DemModel::apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor) {
   ParticleSet& p = particles;
-  for (std::size_t i = 0; i < p.size(); ++i) p.inv_mass[i] /= std::max(alpha(p.position[i]), mass_floor);
+  contact_weight_.resize(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    contact_weight_[i] = alpha(p.position[i]);
+    p.inv_mass[i] /= std::max(contact_weight_[i], mass_floor);
+  }
   std::vector<double> factor;
   for (auto& set : bond_sets_) {
     factor.resize(set->size());
@@ -326,7 +335,7 @@ double DemModel::compute_forces(const ForceScan& scan, bool cleared) {
   if (!contact_) return 0.0;
   const PhaseTimer timer(profile_, phase_.contacts, false);
   std::fill(touching_.begin(), touching_.end(), 0u);
-  deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles, touching_);
+  deepest_contact_ = contact_->accumulate_forces(*neighbours_, particles, touching_, contact_weight_);
   return deepest_contact_.friction_power;
 }
 
@@ -479,7 +488,7 @@ Energies DemModel::energies() const {
   e.kinetic = kinetic_energy();
   use_energy_record();
   for (const auto& set : bond_sets_) e.bond += set->recorded_energy();
-  if (contact_) e.contact = contact_->energy(*neighbours_, particles);
+  if (contact_) e.contact = contact_->energy(*neighbours_, particles, contact_weight_);
   e.external_work = external_work_;
   // Gravity is conservative: its work is the drop of m g . x, exact whatever the path (driven
   // components excluded: gravity does not act on them).

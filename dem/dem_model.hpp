@@ -72,8 +72,9 @@ class DemModel {
 
   // Arlequin weighting (docs/theory.md#weighted-models): every DE's mass (and so its inertia) is
   // multiplied by max(alpha(x_i), mass_floor), every bond's stiffness by alpha at its
-  // midpoint. Call once, after the bonds are added and before finalize(). Contacts are not
-  // weighted (a coupled zone is bonded).
+  // midpoint, every contact's force and energy by the smaller alpha of its two DEs (alpha at
+  // the DEs' present positions here, i.e. the reference: a constant per pair, so contacts stay
+  // conservative). Call once, after the bonds are added and before finalize().
   void apply_arlequin_weight(const std::function<double(const Vec3&)>& alpha, double mass_floor);
 
   // RDEF (dem/rdef.hpp) on top of the bond laws' own criteria.
@@ -163,6 +164,9 @@ class DemModel {
   void check_contact_resolution(const ContactResolution& worst) const;
   // DE i's row of the frequency bound (1/s^2) from `contacts` contacts (critical_time_step).
   double contact_frequency_bound(std::size_t i, std::uint32_t contacts) const;
+  // alpha_i / m_i: a weighted contact's stiffness over a DE's weighted mass is at most
+  // K alpha_i / m_i (its pairs weigh min(alpha_i, alpha_j)), never above the unweighted K / m.
+  double contact_inv_mass(std::size_t i) const;
   // The scan that records, in the step's force pass, what apply_failures() needs.
   ForceScan failure_scan();
   void record_reactions();
@@ -192,7 +196,8 @@ class DemModel {
   ContactPass deepest_contact_;  // of the last force pass
   std::vector<std::uint32_t> touching_;        // per DE: its touching contacts in the last force pass
   std::vector<double> bond_frequency_bound_;   // per DE: its bonds' translational row of the bound, 1/s^2
-  double inv_mass_max_ = 0.0;                  // 1/kg, of the lightest DE
+  double inv_mass_max_ = 0.0;                  // 1/kg, the largest contact_inv_mass
+  std::vector<double> contact_weight_;         // per DE: its Arlequin weight alpha (empty: none)
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)

@@ -7,6 +7,7 @@
 
 #include "common/convex_polyhedron.hpp"
 #include "common/error.hpp"
+#include "dem/neighbour_list.hpp"
 
 namespace arlequin::dem {
 
@@ -16,16 +17,28 @@ namespace {
 // neighbour whose radical plane made it (-1: the box).
 template <class OnCell>
 void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, const std::vector<std::uint32_t>& cells,
-                   OnCell&& on_cell) {
+                   const Box* within, OnCell&& on_cell) {
   const std::size_t n = c.size();
   if (n == 0) return;
   Vec3 lo = c[0], hi = c[0];
-  double r_max = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
-    r_max = std::max(r_max, r[i]);
-  }
   const double tol = 1e-12 * norm(hi - lo);
+  if (within)
+    for (int k = 0; k < 3; ++k) lo[k] = std::max(lo[k], within->lower[k]), hi[k] = std::min(hi[k], within->upper[k]);
+  // Spheres far larger than the median (an impactor among yarn DEs) are a neighbour of every
+  // cell rather than binned: binned, they would set the bins' size to theirs.
+  std::vector<double> sorted(r);
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(n / 2), sorted.end());
+  const double large = NeighbourList::large_radius_ratio * sorted[n / 2];
+  std::vector<std::size_t> large_ones;
+  double r_max = 0.0;  // of the binned spheres
+  for (std::size_t i = 0; i < n; ++i) {
+    if (r[i] > large)
+      large_ones.push_back(i);
+    else
+      r_max = std::max(r_max, r[i]);
+  }
   // Candidates from a uniform grid of cells of size `cell`; a search reaches `reach` cells out.
   const double cell = 2.0 * r_max;
   int dims[3];
@@ -33,13 +46,15 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
   auto cell_of = [&](const Vec3& x, int k) { return std::clamp(static_cast<int>((x[k] - lo[k]) / cell), 0, dims[k] - 1); };
   std::vector<std::vector<std::size_t>> bins(static_cast<std::size_t>(dims[0]) * dims[1] * dims[2]);
   for (std::size_t i = 0; i < n; ++i)
-    bins[(static_cast<std::size_t>(cell_of(c[i], 2)) * dims[1] + cell_of(c[i], 1)) * dims[0] + cell_of(c[i], 0)].push_back(i);
+    if (r[i] <= large)
+      bins[(static_cast<std::size_t>(cell_of(c[i], 2)) * dims[1] + cell_of(c[i], 1)) * dims[0] + cell_of(c[i], 0)].push_back(i);
 
   std::vector<std::pair<double, std::size_t>> near;
   for (std::size_t k = 0; k < cells.size(); ++k) {
     const std::size_t i = cells[k];
     for (int reach = 2;; reach *= 2) {
-      // Every sphere within `reach` cells, nearest first (so later planes rarely cut).
+      // Every sphere within `reach` cells and every large one, nearest first (so later planes
+      // rarely cut).
       near.clear();
       const int ci[3] = {cell_of(c[i], 0), cell_of(c[i], 1), cell_of(c[i], 2)};
       for (int z = std::max(0, ci[2] - reach); z <= std::min(dims[2] - 1, ci[2] + reach); ++z)
@@ -47,6 +62,8 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
           for (int x = std::max(0, ci[0] - reach); x <= std::min(dims[0] - 1, ci[0] + reach); ++x)
             for (std::size_t j : bins[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x])
               if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+      for (std::size_t j : large_ones)
+        if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
       std::sort(near.begin(), near.end());
       Polyhedron poly = box_polyhedron(lo, hi, -1);
       for (const auto& [d2, j] : near) {
@@ -59,7 +76,7 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
       }
       // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
       // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
-      // outside the searched cells is at least `reach` cells away.
+      // outside the searched cells is a binned one at least `reach` cells away.
       double extent = 0.0;
       for (const PolyFace& f : poly)
         for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - c[i]));
@@ -77,9 +94,9 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
 
 std::vector<double> laguerre_cell_measures(const std::vector<Vec3>& c, const std::vector<double>& r,
                                            const std::vector<std::uint32_t>& cells,
-                                           const std::function<double(const Polyhedron&)>& measure) {
+                                           const std::function<double(const Polyhedron&)>& measure, const Box* within) {
   std::vector<double> values(cells.size(), 0.0);
-  for_each_cell(c, r, cells, [&](std::size_t k, const Polyhedron& poly) { values[k] = measure(poly); });
+  for_each_cell(c, r, cells, within, [&](std::size_t k, const Polyhedron& poly) { values[k] = measure(poly); });
   return values;
 }
 
@@ -92,7 +109,7 @@ std::vector<double> laguerre_volumes(const std::vector<Vec3>& c, const std::vect
 std::vector<std::vector<LaguerreFace>> laguerre_faces(const std::vector<Vec3>& c, const std::vector<double>& r,
                                                       const std::vector<std::uint32_t>& cells) {
   std::vector<std::vector<LaguerreFace>> faces(cells.size());
-  for_each_cell(c, r, cells, [&](std::size_t k, const Polyhedron& poly) {
+  for_each_cell(c, r, cells, nullptr, [&](std::size_t k, const Polyhedron& poly) {
     for (const PolyFace& f : poly) {
       if (f.tag < 0) continue;
       // Area and centroid by a fan of triangles from the vertex centre (their signed areas share

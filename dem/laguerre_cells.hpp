@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/convex_polyhedron.hpp"
+#include "common/region.hpp"
 #include "common/vec3.hpp"
 
 namespace arlequin::dem {
@@ -22,10 +23,13 @@ std::vector<double> laguerre_volumes(const std::vector<Vec3>& centres, const std
 
 // measure(cell) for the Laguerre cell of each sphere in `cells` (indices into centres), in that
 // order; all spheres take part in the tessellation. E.g. the part of a cell inside a region
-// (the Arlequin overlap's share of a coupled DE, coupling/coupling_operators.hpp).
+// (the Arlequin overlap's share of a coupled DE, coupling/coupling_operators.hpp). within
+// (optional): the cells are cut to this box too (it must hold the cells' centres), which
+// spares the tessellation the parts of cells a measure inside it does not see.
 std::vector<double> laguerre_cell_measures(const std::vector<Vec3>& centres, const std::vector<double>& radii,
                                            const std::vector<std::uint32_t>& cells,
-                                           const std::function<double(const Polyhedron&)>& measure);
+                                           const std::function<double(const Polyhedron&)>& measure,
+                                           const Box* within = nullptr);
 
 // A face between a cell and a neighbour's: area vector (area times the unit normal pointing out
 // of the cell, m^2) and area centroid (m). Faces on the box are not listed.

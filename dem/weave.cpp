@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <numbers>
 
 #include "dem/bonds/spring_bond.hpp"
@@ -206,7 +207,7 @@ Geometry check_geometry(const WeaveSpec& s) {
 
 }  // namespace
 
-WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
+WeaveReport build_weave(DemModel& model, const WeaveSpec& s, const std::function<bool(const Vec3&)>& keep) {
   const Geometry g = check_geometry(s);
   WeaveReport report;
   report.radius = g.R;
@@ -256,15 +257,19 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
   for (int i = 0; i + 1 < g.columns_x; ++i) add("binder_" + std::to_string(i), 2, g.binder(i, A));
   report.deepest_overlap = deepest_overlap(draft, g.R);
 
-  // DEs: each yarn's mass rho S L_y shared equally by its DEs.
+  // DEs: each yarn's mass rho S L_y shared equally by its DEs (those kept are created).
   ParticleSet& p = model.particles;
-  const std::uint32_t base = static_cast<std::uint32_t>(p.size());
-  p.reserve(p.size() + draft.x.size());
+  constexpr std::uint32_t not_kept = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> id(draft.x.size(), not_kept);
   const double de_volume = 4.0 / 3.0 * pi * g.R * g.R * g.R;
   for (const Yarn& y : yarns) {
     const double yarn_mass = s.density * s.section * y.length;
     const double de_mass = yarn_mass / double(y.end - y.first);
-    for (std::size_t n = y.first; n < y.end; ++n) p.inv_mass[p.add(draft.x[n], g.R, de_mass / de_volume)] = 1.0 / de_mass;
+    for (std::size_t n = y.first; n < y.end; ++n)
+      if (!keep || keep(draft.x[n])) {
+        id[n] = static_cast<std::uint32_t>(p.add(draft.x[n], g.R, de_mass / de_volume));
+        p.inv_mass[id[n]] = 1.0 / de_mass;
+      }
     report.mass += yarn_mass;
   }
 
@@ -278,16 +283,18 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
   }
   for (const Yarn& y : yarns)
     for (std::size_t n = y.first; n + 1 < y.end; ++n)
-      if (draft.chain[n] == draft.chain[n + 1]) {
-        sets[y.family]->add(base + std::uint32_t(n), base + std::uint32_t(n + 1), p);
+      if (draft.chain[n] == draft.chain[n + 1] && id[n] != not_kept && id[n + 1] != not_kept) {
+        sets[y.family]->add(id[n], id[n + 1], p);
         ++report.springs;
       }
 
-  // Groups: families, yarns, the clamped edges.
+  // Groups: families, yarns (those with DEs kept), the clamped edges.
   std::vector<std::uint32_t> family_members[3];
   for (const Yarn& y : yarns) {
     std::vector<std::uint32_t> ids;
-    for (std::size_t n = y.first; n < y.end; ++n) ids.push_back(base + std::uint32_t(n));
+    for (std::size_t n = y.first; n < y.end; ++n)
+      if (id[n] != not_kept) ids.push_back(id[n]);
+    if (ids.empty()) continue;
     family_members[y.family].insert(family_members[y.family].end(), ids.begin(), ids.end());
     model.add_group(y.name, std::move(ids));
   }
@@ -295,7 +302,7 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
   std::vector<std::uint32_t> edges;
   for (std::size_t n = 0; n < draft.x.size(); ++n) {
     const Vec3& x = draft.x[n];
-    if (std::min({x.x, s.length_x - x.x, x.y, s.length_y - x.y}) < s.clamp_width) edges.push_back(base + std::uint32_t(n));
+    if (id[n] != not_kept && std::min({x.x, s.length_x - x.x, x.y, s.length_y - x.y}) < s.clamp_width) edges.push_back(id[n]);
   }
   model.add_group("edges", std::move(edges));
 
@@ -309,7 +316,8 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s) {
   report.areal_density = report.mass / (s.length_x * s.length_y);
   report.fibre_volume_fraction = s.section * total_length / (s.length_x * s.length_y * report.thickness);
   report.spring_stiffness = EA / (2.0 * g.R);
-  report.des = draft.x.size();
+  report.des = std::size_t(std::count_if(id.begin(), id.end(), [](std::uint32_t i) { return i != not_kept; }));
+  report.des_not_kept = draft.x.size() - report.des;
   return report;
 }
 

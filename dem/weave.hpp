@@ -30,6 +30,7 @@
 // cross the weft at the given crimp), before anything is added.
 #pragma once
 #include <cstddef>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -69,6 +70,7 @@ struct WeaveReport {
   double spring_stiffness = 0.0;                   // K of a spring of rest length 2R, N/m
   double mass = 0.0;                               // of all yarns, kg
   std::size_t des = 0, springs = 0;
+  std::size_t des_not_kept = 0;                    // refused by build_weave's keep
   double deepest_overlap = 0.0;                    // over 2R, of two DEs not joined by a spring
 };
 
@@ -86,6 +88,9 @@ class WeaveError : public std::invalid_argument {
 // crossing yarns touch by construction, and the sampled curves round that contact off.
 inline constexpr double weave_overlap_tolerance = 0.001;
 
-WeaveReport build_weave(DemModel& model, const WeaveSpec& spec);
+// keep (optional): only the DEs whose centre it accepts are created, with the springs between
+// two of them and the groups' members among them; the report's yarn figures stay the whole
+// fabric's, `des` and `springs` count what was created (a coupled scene's DEM patch).
+WeaveReport build_weave(DemModel& model, const WeaveSpec& spec, const std::function<bool(const Vec3&)>& keep = {});
 
 }  // namespace arlequin::dem

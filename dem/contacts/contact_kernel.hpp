@@ -28,10 +28,10 @@ class ContactKernelLaw : public ContactLaw {
  public:
   std::string_view law() const override { return Law::name; }
 
-  ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p,
-                                std::span<std::uint32_t> touching = {}) const override {
+  ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p, std::span<std::uint32_t> touching = {},
+                                std::span<const double> weight = {}) const override {
     const double mu = self().friction();
-    const bool count = !touching.empty();
+    const bool count = !touching.empty(), weighted = !weight.empty();
     ContactPass pass;
     for (auto [i, j] : list.pairs()) {
       const Vec3 d = p.position[j] - p.position[i];
@@ -39,7 +39,8 @@ class ContactKernelLaw : public ContactLaw {
       const double dist2 = norm2(d);
       if (dist2 >= reach * reach) continue;  // a listed pair that does not touch
       const double distance = std::sqrt(dist2);
-      const Vec3 f_j = self().force_on_j(d, distance, reach);
+      Vec3 f_j = self().force_on_j(d, distance, reach);
+      if (weighted) f_j *= std::min(weight[i], weight[j]);
       p.force[i] -= f_j;
       p.force[j] += f_j;
       if (count) ++touching[i], ++touching[j];
@@ -51,11 +52,11 @@ class ContactKernelLaw : public ContactLaw {
     return pass;
   }
 
-  double energy(const NeighbourList& list, const ParticleSet& p) const override {
+  double energy(const NeighbourList& list, const ParticleSet& p, std::span<const double> weight = {}) const override {
     double e = 0.0;
     for (auto [i, j] : list.pairs()) {
       const double overlap = p.radius[i] + p.radius[j] - norm(p.position[j] - p.position[i]);
-      if (overlap > 0.0) e += self().energy_of(overlap);
+      if (overlap > 0.0) e += self().energy_of(overlap) * (weight.empty() ? 1.0 : std::min(weight[i], weight[j]));
     }
     return e;
   }

@@ -9,6 +9,9 @@
 // counted); energy() is the elastic energy of
 // those contacts; stiffness() is the largest normal stiffness a contact can have (N/m), for the
 // critical time step. One virtual call per batch of pairs, none per pair.
+// Arlequin weight (weight: one per DE, or empty for none): a pair's force, friction and
+// energy are scaled by the smaller of its two DEs' weights, a constant per pair, so the
+// weighted force stays the gradient of the weighted energy (docs/theory.md#weighted-models).
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -37,9 +40,9 @@ class ContactLaw {
  public:
   virtual ~ContactLaw() = default;
   virtual std::string_view law() const = 0;
-  virtual ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p,
-                                         std::span<std::uint32_t> touching = {}) const = 0;
-  virtual double energy(const NeighbourList& list, const ParticleSet& p) const = 0;
+  virtual ContactPass accumulate_forces(const NeighbourList& list, ParticleSet& p, std::span<std::uint32_t> touching = {},
+                                        std::span<const double> weight = {}) const = 0;
+  virtual double energy(const NeighbourList& list, const ParticleSet& p, std::span<const double> weight = {}) const = 0;
   virtual double stiffness() const = 0;
 };
 

@@ -146,3 +146,25 @@ TEST(ContinuumMaterial, TransverselyIsotropicCompliance) {
   const Material ti = Material::transversely_isotropic(2e11, 2e11, 0.3, 0.3, 2e11 / 2.6, a, 7800);
   EXPECT_LT((iso.C - ti.C).norm(), 1e-6 * iso.C.norm());
 }
+
+TEST(ContinuumMaterial, OrthotropicComplianceAndItsLimits) {
+  // Unit uniaxial stresses and shears in the x, y, z axes give the engineering constants back:
+  // eps_i = 1 / E_i, eps_j = -nu_ij / E_i, gamma = 1 / G (a woven plate's constants).
+  const std::array<double, 3> E{7.3e9, 4.8e9, 5e6}, G{4e6, 3e6, 2e6}, nu{0.01, 0.05, 0.3};
+  const Material m = Material::orthotropic(E, G, nu, 338.0);
+  const Stiffness S = m.C.inverse();
+  EXPECT_NEAR(S(0, 0) * E[0], 1.0, 1e-12);
+  EXPECT_NEAR(S(1, 1) * E[1], 1.0, 1e-12);
+  EXPECT_NEAR(S(2, 2) * E[2], 1.0, 1e-10);
+  EXPECT_NEAR(-S(1, 0) * E[0], nu[0], 1e-12);  // eps_y under sigma_x
+  EXPECT_NEAR(-S(2, 0) * E[0], nu[1], 1e-12);  // eps_z under sigma_x
+  EXPECT_NEAR(-S(2, 1) * E[1], nu[2], 1e-12);  // eps_z under sigma_y
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(S(3 + k, 3 + k) * G[k], 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(m.density, 338.0);
+  // The isotropic limit, and a compliance that is not positive definite refused.
+  const Material iso = Material::isotropic(2e11, 0.3, 7800);
+  const Material ortho = Material::orthotropic({2e11, 2e11, 2e11}, {2e11 / 2.6, 2e11 / 2.6, 2e11 / 2.6}, {0.3, 0.3, 0.3}, 7800);
+  EXPECT_LT((iso.C - ortho.C).norm(), 1e-6 * iso.C.norm());
+  EXPECT_THROW(Material::orthotropic({1e9, 1e9, 1e9}, {1e8, 1e8, 1e8}, {0.9, 0.9, 0.9}, 1000), InputError);
+  EXPECT_THROW(Material::orthotropic({1e9, 1e9, 1e9}, {1e8, 0.0, 1e8}, {0, 0, 0}, 1000), InputError);
+}

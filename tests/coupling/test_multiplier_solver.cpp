@@ -89,3 +89,51 @@ TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
   for (const auto& backend : backends)
     EXPECT_THROW(MultiplierSolver(ops, {1.0}, {1.0, 1.0, 1.0}, backend), RunError) << (backend ? "PETSc " + *backend : "LDL^T");
 }
+
+// The fine mediator (G_d = W diagonal, G_c = -W N) is solved by the Woodbury form; the same
+// matrices through the general LDL^T (the operators marked coarse, which that path does not
+// look at) give the same multipliers to round-off, both project onto ker G, and a held node
+// (inverse mass 0 in one component) keeps its velocity. 30 DEs, 8 nodes, each DE interpolated
+// from three nodes with positive weights summing to 1.
+TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFactor) {
+  const int np = 30, nn = 8;
+  CouplingOperators fine;
+  fine.settings.mediator = Mediator::fine;
+  fine.N.resize(np, nn);
+  fine.Gd.resize(np, np);
+  fine.Gc.resize(np, nn);
+  std::vector<double> md(np), mc(3 * nn);
+  for (int p = 0; p < np; ++p) {
+    fine.particles.push_back(static_cast<std::uint32_t>(p));
+    const double w = 1e-9 * (1.0 + 0.5 * std::sin(p));  // m^3, a DE's share of the overlap
+    const double a = 0.2 + 0.1 * std::cos(3.0 * p), b = 0.3;
+    const int nodes[3] = {p % nn, (p + 3) % nn, (p + 5) % nn};
+    const double N[3] = {a, b, 1.0 - a - b};
+    fine.Gd.insert(p, p) = w;
+    for (int k = 0; k < 3; ++k) {
+      fine.N.insert(p, nodes[k]) = N[k];
+      fine.Gc.insert(p, nodes[k]) = -w * N[k];
+    }
+    md[p] = 1.0 / (1e-7 * (1.0 + 0.3 * std::cos(p)));  // DE masses ~0.1 mg
+  }
+  for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * (d / 3)));  // node masses ~5 mg
+  mc[3 * 2 + 1] = 0.0;  // node 2 held along y
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;
+  const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
+  EXPECT_EQ(factor.backend(), "LDL^T");
+  EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
+  EXPECT_EQ(woodbury.systems(), 2);  // y differs from x, z reuses x's
+
+  Matrix3 vd(np, 3), vc(nn, 3);
+  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
+  for (int i = 0; i < nn; ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
+  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc, dd, dc, lambda_w, lambda_f, residual;
+  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
+  factor.project(vd_f, vc_f, dd, dc, lambda_f);
+  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
+  EXPECT_LT((vd_w - vd_f).norm(), 1e-10 * vd.norm());
+  woodbury.residual(vd_w, vc_w, residual);
+  EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
+  EXPECT_EQ(vc_w(2, 1), vc(2, 1));                      // the held dof
+}

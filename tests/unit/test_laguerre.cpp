@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "common/convex_polyhedron.hpp"
+#include "common/region.hpp"
 #include "dem/laguerre_cells.hpp"
 
 using namespace arlequin;
@@ -130,4 +132,65 @@ TEST(LaguerreCells, FacesCloseEveryInteriorCell) {
       for (int j = 0; j < 3; ++j) EXPECT_NEAR(moment[k][j], k == j ? volumes[i] : 0.0, 1e-10 * volumes[i]) << "cell " << i;
   }
   EXPECT_GT(interior, 50);
+}
+
+// An impactor among small spheres (a radius far above the median, kept out of the search's
+// bins): every cell equals its brute force (the box clipped by every other sphere's radical
+// plane), and the cells tile the box.
+TEST(LaguerreCells, ALargeSphereAmongSmallOnesGivesTheBruteForceCells) {
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  random_spheres(5, 300, c, r);
+  c.push_back({0.5, 0.5, 1.3});  // an impactor above the cloud, radius 0.35 (> 4 x the median)
+  r.push_back(0.35);
+  Vec3 lo = c[0], hi = c[0];
+  for (std::size_t i = 0; i < c.size(); ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
+  const auto v = dem::laguerre_volumes(c, r);
+  double sum = 0.0;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    // Brute force: the box clipped by the radical plane of every other sphere.
+    Polyhedron cell = box_polyhedron(lo, hi, -1);
+    for (std::size_t j = 0; j < c.size(); ++j) {
+      if (j == i) continue;
+      const Vec3 e = c[j] - c[i];
+      const double d = norm(e);
+      clip(cell, e / d, (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d), int(j), 1e-12);
+    }
+    EXPECT_NEAR(v[i], volume(cell), 1e-12) << "sphere " << i;
+    sum += v[i];
+  }
+  EXPECT_NEAR(sum, (hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z), 1e-10 * sum);
+}
+
+// Cells cut to a box `within` first (the coupling's overlap bounds) measure inside it what the
+// whole cells measure there: the volume inside the box, each cell against its brute force.
+TEST(LaguerreCells, CellsCutToABoxMeasureWhatTheWholeCellsDoInside) {
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  random_spheres(9, 300, c, r);
+  const Box within{{0.2, 0.3, 0.25}, {0.7, 0.6, 0.5}};
+  std::vector<std::uint32_t> inside;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (Region{within}.contains(c[i])) inside.push_back(static_cast<std::uint32_t>(i));
+  ASSERT_GT(inside.size(), 5u);
+  const auto in_box = [&within](const Polyhedron& cell) {
+    Polyhedron p = cell;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 n{};
+      n[k] = 1.0;
+      clip(p, n, within.upper[k], -1, 1e-12);
+      clip(p, -1.0 * n, -within.lower[k], -1, 1e-12);
+    }
+    return volume(p);
+  };
+  const auto whole = dem::laguerre_cell_measures(c, r, inside, in_box);
+  const auto cut = dem::laguerre_cell_measures(c, r, inside, in_box, &within);
+  double sum = 0.0;
+  for (std::size_t k = 0; k < inside.size(); ++k) {
+    EXPECT_NEAR(cut[k], whole[k], 1e-14) << "sphere " << inside[k];
+    EXPECT_GT(cut[k], 0.0);
+    sum += cut[k];
+  }
+  EXPECT_LT(sum, 0.5 * 0.3 * 0.25);  // the cells of the spheres inside cover part of the box
 }
