@@ -87,7 +87,7 @@ Material Material::orthotropic(const std::array<double, 3>& E, const std::array<
                                const std::array<double, 3>& nu, double density) {
   if (!(E[0] > 0 && E[1] > 0 && E[2] > 0 && G[0] > 0 && G[1] > 0 && G[2] > 0 && density > 0))
     throw InputError("orthotropic material needs E_x, E_y, E_z, G_yz, G_xz, G_xy, density > 0");
-  // Compliance in the x, y, z axes (Jones, Mechanics of Composite Materials, Eq. 2.20), with
+  // Compliance in the x, y, z axes (docs/references.md#jones1999, chapter 2), with
   // nu_ij = -eps_j / eps_i under a stress along i, so S_ij = -nu_ij / E_i = -nu_ji / E_j.
   Stiffness S = Stiffness::Zero();
   for (int i = 0; i < 3; ++i) {

@@ -139,8 +139,8 @@ std::string CoupledModel::summary() const {
       << quadrature_correction_.nodes << " free nodes (largest change " << quadrature_correction_.largest_change
       << ", smallest weight " << quadrature_correction_.smallest_weight << " of a point's volume)";
   s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
-    << "coupling matrix A: " << solver_->nonzeros() << " non-zeros, " << solver_->systems() << " system(s) set up once ("
-    << solver_->backend() << ")\n"
+    << "coupling matrix A: " << solver_->backend() << ", " << solver_->nonzeros() << " non-zeros stored, "
+    << solver_->systems() << " system(s) set up once\n"
     << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum
     << " s, coupled " << time_steps_.coupled << " s\n";
   return s.str();

@@ -25,8 +25,7 @@
 //    U = G_c restricted to the continuum dofs it reaches with a non-zero inverse mass, C their
 //    inverse masses. Then A, whose LDL^T fills in wherever two DEs share an element (rows of
 //    thousands of entries for a yarn-dense overlap), is solved exactly by the
-//    Sherman-Morrison-Woodbury identity (Golub & Van Loan, Matrix Computations, 4th ed.,
-//    section 2.1.4): A^-1 r = D^-1 r - D^-1 U K^-1 U^T D^-1 r with K = C^-1 + U^T D^-1 U, a
+//    Sherman-Morrison-Woodbury identity (docs/references.md#golub2013): A^-1 r = D^-1 r - D^-1 U K^-1 U^T D^-1 r with K = C^-1 + U^T D^-1 U, a
 //    matrix over those continuum nodes only, SPD, factored once (LDL^T). A step then costs
 //    O(non-zeros of N). The subtraction is benign when the continuum's nodes outweigh the DEs
 //    they carry (C small against D^-1's scale: the case of a coupling); it is checked at set-up
@@ -71,9 +70,11 @@ class MultiplierSolver {
 
   // Distinct systems (one per distinct column of inverse masses; the others reuse one).
   int systems() const { return static_cast<int>(low_rank_.empty() ? scales_.size() : low_rank_.size()); }
-  // "LDL^T" or "PETSc <ksp> + <pc>".
+  // "LDL^T", "diagonal + low rank (Woodbury), LDL^T of <k> continuum dofs" or "PETSc <ksp> + <pc>".
   std::string backend() const;
   int rows() const { return ops_->rows(); }
+  // Non-zeros of what a solve reads: the scaled A (its factor fills in more), or U for the
+  // low-rank form.
   long nonzeros() const { return nonzeros_; }
 
  private:

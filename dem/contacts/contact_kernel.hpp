@@ -40,13 +40,16 @@ class ContactKernelLaw : public ContactLaw {
       if (dist2 >= reach * reach) continue;  // a listed pair that does not touch
       const double distance = std::sqrt(dist2);
       Vec3 f_j = self().force_on_j(d, distance, reach);
-      if (weighted) f_j *= std::min(weight[i], weight[j]);
+      const double w = weighted ? std::min(weight[i], weight[j]) : 1.0;
+      if (weighted) f_j *= w;
       p.force[i] -= f_j;
       p.force[j] += f_j;
       if (count) ++touching[i], ++touching[j];
       if (mu > 0.0) pass.friction_power += add_friction(i, j, d / distance, 0.5 * (reach - distance), norm(f_j), mu, p);
-      const double depth = (reach - distance) / std::min(p.radius[i], p.radius[j]);
       ++pass.touching;
+      // The deepest contact is watched where the DEM alone holds the pair (weight 1): in a
+      // coupling overlap the continuum carries the share the weighted contact does not.
+      const double depth = w < 1.0 ? 0.0 : (reach - distance) / std::min(p.radius[i], p.radius[j]);
       if (depth > pass.deepest) pass = {pass.friction_power, depth, i, j, pass.touching};
     }
     return pass;

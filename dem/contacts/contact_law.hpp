@@ -4,7 +4,8 @@
 // Contract: accumulate_forces() adds forces/torques for every listed pair that is actually
 // touching (|x_i - x_j| < R_i + R_j) and returns the power its friction dissipates at the
 // present velocities (W, >= 0; 0 for a frictionless law) and the deepest contact (its overlap
-// over the pair's smaller radius, and the pair), and adds one to touching[i] and touching[j]
+// over the pair's smaller radius, and the pair; among the pairs of weight 1 when weighted,
+// below), and adds one to touching[i] and touching[j]
 // for each touching pair (touching: one count per DE, zeroed by the caller; empty: not
 // counted); energy() is the elastic energy of
 // those contacts; stiffness() is the largest normal stiffness a contact can have (N/m), for the

@@ -84,6 +84,9 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
                   "axis: [1, 0, 0], density: 1500}",
                   "continuum.boundary=[{group: xmin, type: traction, value: [1, 0, 0]}]"},
             dir_);
+  read_case(bar, {"continuum.material={model: orthotropic, E_x: 7.0e9, E_y: 5.0e9, E_z: 5.0e6, G_xy: 4.0e6, G_xz: 3.0e6, "
+                  "G_yz: 2.0e6, nu_xy: 0.01, nu_xz: 0.02, nu_yz: 0.03, density: 338}"},
+            dir_);
   read_case(cases + "dcb/case.yaml",
             {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
              "groups=[{name: load_top, region: {box: [[-1, -1, 0.0015], [5.0e-4, 1, 1]]}}, "
