@@ -82,7 +82,8 @@ constexpr KeyDoc coupling_keys[] = {
     {"solver", KeyType::choice, "", {}, "petsc", "the multiplier solve: PETSc (options below) or our sparse LDL^T", "petsc | direct"},
     {"petsc_options", KeyType::string, "", {}, "", "solver: petsc: PETSc options of the multiplier system (prefix coupling_)"},
     {"on_damage_in_overlap", KeyType::choice, "", {}, "stop",
-     "a bond the coupling weights (weight < 1) breaks: stop the run, or say so once and go on", "stop | warn"},
+     "a bond the coupling weights (weight < 1) breaks: stop the run, say so once and go on, or hold such bonds intact "
+     "(say so once)", "stop | warn | hold"},
 };
 constexpr KeyDoc overlap_keys[] = {
     {"shell", KeyType::section, "", {}, "(none)", "the space between two boxes, the DEM inside (instead of a region)"},
@@ -322,8 +323,10 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   out.options.coupling.type = coupling::coupling_type_from_name(section.choice_or("type", "l2", types));
   if (out.options.coupling.type == coupling::CouplingType::h1)
     out.options.coupling.length = section.number("length", Range::positive(), "m");
-  static constexpr std::string_view on_damage[] = {"stop", "warn"};
-  out.stop_on_damage_in_overlap = section.choice_or("on_damage_in_overlap", "stop", on_damage) == "stop";
+  static constexpr std::string_view on_damage[] = {"stop", "warn", "hold"};
+  const std::string on_damage_in_overlap = section.choice_or("on_damage_in_overlap", "stop", on_damage);
+  out.stop_on_damage_in_overlap = on_damage_in_overlap == "stop";
+  out.options.hold_overlap_failures = on_damage_in_overlap == "hold";
   static constexpr std::string_view quadratures[] = {"plain", "consistent"};
   out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
   static constexpr std::string_view solvers[] = {"petsc", "direct"};
@@ -352,9 +355,11 @@ class Coupled final : public SceneModel {
     const dem::BondSet& set = *dem_.bond_sets()[e.set];
     std::ostringstream line;
     line << "damage reached the coupling overlap: bond " << e.bond << " of '" << set.name << "' (DEs " << set.first()[e.bond]
-         << " and " << set.second()[e.bond] << ") broke at t = " << e.time << " s where the DEM's weight is " << damage->weight;
+         << " and " << set.second()[e.bond] << ") " << (damage->held ? "met its failure criterion" : "broke") << " at t = " << e.time
+         << " s where the DEM's weight is " << damage->weight;
     if (damage->breaks > 1) line << " (and " << damage->breaks - 1 << " more there in the step)";
-    return OverlapDamageReport{line.str(), damage->breaks, stop_on_damage_};
+    if (damage->held) line << "; held intact";
+    return OverlapDamageReport{line.str(), damage->breaks, stop_on_damage_ && !damage->held, damage->held};
   }
   double critical_time_step() const override { return model_->critical_time_step(); }
   SceneEnergies energies() const override {

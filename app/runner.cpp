@@ -627,7 +627,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
           if (damage->stop)
             throw RunError(result.damage_in_overlap + "; the run stops (coupling.on_damage_in_overlap: stop; warn goes on)");
           if (first)
-            std::fprintf(stderr, "  warning: %s; the run goes on (coupling.on_damage_in_overlap: warn)\n", result.damage_in_overlap.c_str());
+            std::fprintf(stderr, "  warning: %s; the run goes on (coupling.on_damage_in_overlap: %s)\n", result.damage_in_overlap.c_str(),
+                         damage->held ? "hold" : "warn");
         }
         if (n % 50 == 0 || n == total_steps)
           model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +

@@ -42,6 +42,7 @@ struct OverlapDamageReport {
   std::string description;  // of the first such break
   std::size_t breaks = 0;   // all of them since the last look
   bool stop = true;
+  bool held = false;        // the bonds were held intact, not broken
 };
 
 class SceneModel {

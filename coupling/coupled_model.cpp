@@ -62,6 +62,13 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
     : dem_(dem), continuum_(continuum), zone_(zone), options_(std::move(options)) {
   continuum_stiffness_floored_ = weight_models(dem_, continuum_, zone_);
   dem_.finalize();
+  if (options_.hold_overlap_failures) {  // after finalize, which orders the bonds
+    const auto& reference = dem_.particles.reference;
+    dem_.hold_failures([&](std::size_t s, std::size_t b) {
+      const dem::BondSet& set = *dem_.bond_sets()[s];
+      return zone_.alpha_d(0.5 * (reference[set.first()[b]] + reference[set.second()[b]])) < 1.0;
+    });
+  }
   ops_ = CouplingOperators::build(zone_, dem_.particles, continuum_, options_.coupling);
   if (options_.consistent_quadrature) make_overlap_quadrature_consistent();
   continuum_.compute_forces();
@@ -195,17 +202,20 @@ void CoupledModel::kick_to_trial(double dt) {
 }
 
 std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
-  const auto& breaks = dem_.breaks();
   const auto& reference = dem_.particles.reference;
   std::optional<OverlapDamage> damage;
-  for (; breaks_looked_at_ < breaks.size(); ++breaks_looked_at_) {
-    const dem::BreakEvent& e = breaks[breaks_looked_at_];
-    const dem::BondSet& set = *dem_.bond_sets()[e.set];
-    const double weight = zone_.alpha_d(0.5 * (reference[set.first()[e.bond]] + reference[set.second()[e.bond]]));
-    if (!(weight < 1.0)) continue;
-    if (!damage) damage = OverlapDamage{0, e, weight};
-    ++damage->breaks;
-  }
+  const auto look = [&](const std::vector<dem::BreakEvent>& events, std::size_t& looked_at, bool held) {
+    for (; looked_at < events.size(); ++looked_at) {
+      const dem::BreakEvent& e = events[looked_at];
+      const dem::BondSet& set = *dem_.bond_sets()[e.set];
+      const double weight = zone_.alpha_d(0.5 * (reference[set.first()[e.bond]] + reference[set.second()[e.bond]]));
+      if (!(weight < 1.0)) continue;
+      if (!damage) damage = OverlapDamage{0, e, weight, held};
+      ++damage->breaks;
+    }
+  };
+  look(dem_.breaks(), breaks_looked_at_, false);
+  look(dem_.held_failures(), held_looked_at_, true);
   return damage;
 }
 

@@ -88,6 +88,9 @@ struct CoupledOptions {
   std::optional<std::string> multiplier_petsc_options = std::string();
   std::vector<int> held_continuum_dofs;     // 3 * node + component
   std::vector<std::uint32_t> driven_des;    // DEs with kinematic boundary conditions
+  // Bonds of the overlap (alpha_d < 1 at their midpoint) do not break when their criterion is
+  // met: the continuum they share the load with cannot (coupling.on_damage_in_overlap: hold).
+  bool hold_overlap_failures = false;
 };
 
 // The dofs of a continuum physical group (for held_continuum_dofs).
@@ -129,9 +132,10 @@ struct CouplingMonitor {
 // Bonds that broke where the coupling weighted them (their set-up midpoint in the overlap, the
 // DEM's weight there below 1): the coupling's operators assume that material intact.
 struct OverlapDamage {
-  std::size_t breaks = 0;  // such breaks since the last look
+  std::size_t breaks = 0;  // such breaks (or held failures) since the last look
   dem::BreakEvent first;   // the first of them
   double weight = 1.0;     // alpha_d at its bond's midpoint
+  bool held = false;       // the bonds were held intact (options.hold_overlap_failures)
 };
 
 class CoupledModel {
@@ -159,7 +163,9 @@ class CoupledModel {
   double displacement_residual() const;
 
   // The breaks since the last call whose bonds lie where the DEM's weight is below 1 (count and
-  // first; nullopt if none): each break of the DEM is looked at once.
+  // first; nullopt if none): each break of the DEM is looked at once. With
+  // hold_overlap_failures, the bonds held intact there instead (held).
+  // A restart lists the held bonds again (which ones are held is not in the checkpoint).
   std::optional<OverlapDamage> damage_in_overlap();
 
   // Checkpoint (docs/restart.md): both models' states (DemModel::save_state,
@@ -196,6 +202,7 @@ class CoupledModel {
   continuum::ContinuumSolver& continuum_;
   OverlapZone zone_;
   std::size_t breaks_looked_at_ = 0;  // damage_in_overlap()
+  std::size_t held_looked_at_ = 0;    // damage_in_overlap()
   CoupledOptions options_;
   CouplingOperators ops_;
   std::unique_ptr<MultiplierSolver> solver_;

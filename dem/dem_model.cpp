@@ -264,6 +264,14 @@ void DemModel::apply_arlequin_weight(const std::function<double(const Vec3&)>& a
   }
 }
 
+void DemModel::hold_failures(const std::function<bool(std::size_t, std::size_t)>& held) {
+  held_.resize(bond_sets_.size());
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+    held_[s].assign(bond_sets_[s]->size(), 0);
+    for (std::size_t b = 0; b < held_[s].size(); ++b) held_[s][b] = held(s, b) ? 1 : 0;
+  }
+}
+
 void DemModel::kick(double half_dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
@@ -370,13 +378,21 @@ bool DemModel::break_failed_bonds() {
     bond_sets_[s]->find_failures(particles, static_cast<std::uint32_t>(s), time_, new_breaks_);
   if (rdef_) rdef_->find_failures(particles, bond_sets_, time_, new_breaks_);
   if (new_breaks_.empty()) return false;
+  bool broke = false;
   for (const BreakEvent& e : new_breaks_) {
     BondSet& set = *bond_sets_[e.set];
     if (set.broken()[e.bond]) continue;  // reported twice (BBF and RDEF): break once
+    if (!held_.empty() && held_[e.set][e.bond] != 0) {
+      if (held_[e.set][e.bond] == 1) held_failures_.push_back(e);
+      held_[e.set][e.bond] = 2;
+      continue;
+    }
     set.break_bond(e.bond);
     fracture_ += e.energy;
     breaks_.push_back(e);
+    broke = true;
   }
+  if (!broke) return false;
   // Former partners now meet by contact; the step's forces (and the energy record) are
   // recomputed without the bonds.
   if (neighbours_) {

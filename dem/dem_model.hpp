@@ -103,6 +103,12 @@ class DemModel {
 
   // Every break so far, in order; broken bonds' energy is in Energies::fracture.
   const std::vector<BreakEvent>& breaks() const { return breaks_; }
+  // Bonds whose failure criterion is held in abeyance (a coupling overlap, where the continuum
+  // cannot break: coupling.on_damage_in_overlap: hold): held(set, bond) true keeps the bond intact
+  // when its criterion is met; each such bond is listed once in held_failures(), as the break it
+  // would have been. After finalize() (which orders the bonds), before the first step.
+  void hold_failures(const std::function<bool(std::size_t set, std::size_t bond)>& held);
+  const std::vector<BreakEvent>& held_failures() const { return held_failures_; }
   bool failure_enabled() const { return failure_on_; }
   // Virial stress of every DE over its intact bonds (failure.hpp, seed Eq. 1), Pa, with the
   // volume share Omega_i = sphere volume / compaction.
@@ -198,6 +204,8 @@ class DemModel {
   std::vector<double> bond_frequency_bound_;   // per DE: its bonds' translational row of the bound, 1/s^2
   double inv_mass_max_ = 0.0;                  // 1/kg, the largest contact_inv_mass
   std::vector<double> contact_weight_;         // per DE: its Arlequin weight alpha (empty: none)
+  std::vector<std::vector<std::uint8_t>> held_;  // per set and bond: 1 held, 2 held and its criterion met
+  std::vector<BreakEvent> held_failures_;
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
