@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,8 +29,11 @@ struct Run {
   long nodes = 0, steps = 0;
   bool ok = true;
   bool checks_passed = true;  // the case's own checks (those evaluated)
-
+  std::optional<double> first_break;  // s, summary.json's first_break_time
   double compute_seconds() const { return loop - output; }
+  bool has(const std::string& name_) const { return std::find(columns.begin(), columns.end(), name_) != columns.end(); }
+  // The last row's value of a column, 0 where the run has no such column (a pure DEM's continuum).
+  double last(const std::string& name_) const { return has(name_) && !rows.empty() ? column(name_).back() : 0.0; }
   std::vector<double> column(const std::string& name_) const {
     const std::size_t c = std::find(columns.begin(), columns.end(), name_) - columns.begin();
     std::vector<double> out;
@@ -75,6 +79,7 @@ Run execute(Prepared& prepared, const std::filesystem::path& out) {
   run.loop = summary.at("wall_time").at("time_loop").get<double>();
   run.output = summary.at("wall_time").at("output").get<double>();
   run.steps = long(summary.at("steps").get<std::int64_t>());
+  if (summary.contains("first_break_time")) run.first_break = summary.at("first_break_time").get<double>();
   // series.csv: a header, then rows of numbers.
   std::stringstream csv(read_text_file(out / "series.csv"));
   std::string line;
@@ -117,6 +122,12 @@ Json describe_run(const Run& r) {
   j["output_seconds"] = r.output;
   j["completed"] = r.ok;
   j["checks_passed"] = r.checks_passed;
+  if (r.first_break) j["first_break_time"] = *r.first_break;
+  Json energy = Json::object();
+  energy["dem"] = r.last("E_kinetic") + r.last("E_bond") + r.last("E_contact");
+  energy["continuum"] = r.last("C_kinetic") + r.last("C_strain");
+  energy["fracture"] = r.last("E_fracture");
+  j["energy_at_end"] = energy;
   return j;
 }
 
@@ -145,13 +156,13 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
 
   const auto ta = a.column("time"), tb = b.column("time");
   Json sensors = Json::array();
-  std::string csv = "sensor,max_relative_difference,rms_relative_difference\n";
+  std::string csv = "sensor,max_relative_difference,rms_relative_difference,peak_relative_difference\n";
   std::vector<Plot> plots;
-  std::printf("| sensor | max rel. difference | RMS rel. difference |\n|---|---|---|\n");
+  std::printf("| sensor | max rel. difference | RMS rel. difference | peak rel. difference |\n|---|---|---|---|\n");
   for (std::size_t s = 0; s < shared.size(); ++s) {
     const std::string& name = shared[s];
     const auto va = a.column(name), vb = resample(tb, b.column(name), ta);
-    double max_diff = 0, max_ref = 0, sum_diff = 0, sum_ref = 0;
+    double max_diff = 0, max_ref = 0, max_other = 0, sum_diff = 0, sum_ref = 0;
     for (std::size_t k = 0; k < va.size(); ++k) {
       const double d = vb[k] - va[k];
       max_diff = std::max(max_diff, std::abs(d));
@@ -159,16 +170,19 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       sum_diff += d * d;
       sum_ref += va[k] * va[k];
     }
+    for (double v : b.column(name)) max_other = std::max(max_other, std::abs(v));  // its own peak, not resampled
     const double max_rel = max_diff / std::max(max_ref, 1e-300), rms_rel = std::sqrt(sum_diff / std::max(sum_ref, 1e-300));
+    const double peak_rel = (max_other - max_ref) / std::max(max_ref, 1e-300);
     Json j = Json::object();
     j["sensor"] = name;
     j["max_relative_difference"] = max_rel;
     j["rms_relative_difference"] = rms_rel;
+    j["peak_relative_difference"] = peak_rel;
     sensors.push_back(j);
     char row[256];
-    std::snprintf(row, sizeof row, "%s,%.6g,%.6g\n", name.c_str(), max_rel, rms_rel);
+    std::snprintf(row, sizeof row, "%s,%.6g,%.6g,%.6g\n", name.c_str(), max_rel, rms_rel, peak_rel);
     csv += row;
-    std::printf("| %s | %.3g %% | %.3g %% |\n", name.c_str(), 100 * max_rel, 100 * rms_rel);
+    std::printf("| %s | %.3g %% | %.3g %% | %+.3g %% |\n", name.c_str(), 100 * max_rel, 100 * rms_rel, 100 * peak_rel);
     Plot& plot = plots.emplace_back();
     plot.file = "compare_" + name + ".png";
     plot.title = name + ": " + b.name + " against " + a.name;
@@ -184,6 +198,15 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", b.name.c_str(),
               b.particles, b.nodes, b.steps, b.compute_seconds(), b.setup, b.output);
   std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
+  for (const Run* r : {&a, &b}) {
+    std::printf("%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(),
+                r->last("E_kinetic") + r->last("E_bond") + r->last("E_contact"), r->last("C_kinetic") + r->last("C_strain"),
+                r->last("E_fracture"));
+    if (r->first_break) std::printf("; first break at %.4g s", *r->first_break);
+    std::printf("\n");
+  }
+  if (a.first_break && b.first_break)
+    std::printf("first break: %+.3g %% of the reference's\n", 100 * (*b.first_break - *a.first_break) / *a.first_break);
   for (const Run* r : {&a, &b})
     if (!r->checks_passed) std::printf("%s: a check of its case FAILED (its summary.json says which)\n", r->name.c_str());
 

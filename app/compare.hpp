@@ -4,7 +4,10 @@
 // reference) against both runs' run times and sizes: the user's "error against run time" view.
 //
 // Differences, with b interpolated linearly onto a's output times:
-//   max relative = max |b - a| / max |a|,  RMS relative = rms(b - a) / rms(a).
+//   max relative = max |b - a| / max |a|,  RMS relative = rms(b - a) / rms(a),
+//   peak relative = (max |b| - max |a|) / max |a| (b at its own samples: a peak between a's is kept).
+// Also each run's energies at its end (DEM kinetic + bond + contact, continuum kinetic + strain,
+// fracture) and first break (summary.json), and the second's first break relative to the first's.
 // Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors) and one PNG
 // per sensor overlaying both time histories, into the output folder (atomically).
 #pragma once

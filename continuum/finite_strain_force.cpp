@@ -5,6 +5,8 @@
 #include <map>
 #include <utility>
 
+#include "common/parallel.hpp"
+
 namespace arlequin::continuum {
 
 FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::vector<int>& node,
@@ -21,7 +23,7 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     const size_t lanes = points.size(), m = static_cast<size_t>(key.first);
     b.dof.resize(m * lanes);
     b.gx.resize(m * lanes), b.gy.resize(m * lanes), b.gz.resize(m * lanes);
-    b.force.resize(3 * m * kTile);
+    b.force.resize(3 * m * lanes);
     for (size_t i = 0; i < lanes; ++i)
       for (size_t k = 0; k < m; ++k) {
         const int e = offset[points[i]] + static_cast<int>(k);
@@ -29,6 +31,28 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
         b.gx[k * lanes + i] = grad[e].x, b.gy[k * lanes + i] = grad[e].y, b.gz[k * lanes + i] = grad[e].z;
       }
     batches_.push_back(std::move(b));
+  }
+  // Tiles, and each node's entries in the serial scatter's order (batch, lane, entry).
+  int nodes = 0;
+  for (int n : node) nodes = std::max(nodes, n + 1);
+  gather_start_.assign(static_cast<size_t>(nodes) + 1, 0);
+  for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
+    const Batch& b = batches_[static_cast<size_t>(bi)];
+    const int lanes = static_cast<int>(b.point.size());
+    for (int first = 0; first < lanes; first += kTile) tiles_.emplace_back(bi, first);
+    for (int d : b.dof) ++gather_start_[static_cast<size_t>(d / 3) + 1];
+    entries_ += static_cast<long>(b.dof.size());
+  }
+  for (int n = 0; n < nodes; ++n) gather_start_[static_cast<size_t>(n) + 1] += gather_start_[static_cast<size_t>(n)];
+  gather_.resize(static_cast<size_t>(gather_start_.back()));
+  std::vector<int> next(gather_start_.begin(), gather_start_.end() - 1);
+  for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
+    const Batch& b = batches_[static_cast<size_t>(bi)];
+    const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
+    for (int i = 0; i < lanes; ++i)
+      for (int k = 0; k < m; ++k)
+        gather_[static_cast<size_t>(next[static_cast<size_t>(b.dof[static_cast<size_t>(k) * lanes + i] / 3)]++)] = {
+            bi, 3 * k * lanes + i};
   }
 }
 
@@ -86,7 +110,7 @@ void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const 
   for (int k = 0; k < m; ++k) {
     const size_t e0 = static_cast<size_t>(k) * lanes + first;
     const double *gx = b.gx.data() + e0, *gy = b.gy.data() + e0, *gz = b.gz.data() + e0;
-    double *fx = force + (3 * k) * kTile, *fy = fx + kTile, *fz = fy + kTile;
+    double *fx = force + static_cast<size_t>(3 * k) * lanes + first, *fy = fx + lanes, *fz = fy + lanes;
 #pragma omp simd
     for (int t = 0; t < count; ++t) {
       fx[t] = p[0][t] * gx[t] + p[1][t] * gy[t] + p[2][t] * gz[t];
@@ -99,20 +123,28 @@ void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const 
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
-  for (const Batch& b : batches_) {
-    const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
-    for (int first = 0; first < lanes; first += kTile) {
-      const int count = std::min(kTile, lanes - first);
-      tile_forces(b, first, count, u.data(), w.data());
-      for (int t = 0; t < count; ++t)
-        for (int k = 0; k < m; ++k) {
-          double* f = &f_int[static_cast<size_t>(b.dof[static_cast<size_t>(k) * lanes + first + t])];
-          f[0] += b.force[(3 * k) * kTile + t];
-          f[1] += b.force[(3 * k + 1) * kTile + t];
-          f[2] += b.force[(3 * k + 2) * kTile + t];
-        }
+  const long nodes = static_cast<long>(gather_start_.size()) - 1;
+  run_threaded_if(entries_ > parallel_threshold, [&] {
+#pragma omp for schedule(static)
+    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
+      const auto [bi, first] = tiles_[static_cast<size_t>(t)];
+      const Batch& b = batches_[static_cast<size_t>(bi)];
+      tile_forces(b, first, std::min(kTile, static_cast<int>(b.point.size()) - first), u.data(), w.data());
     }
-  }
+#pragma omp for schedule(static)
+    for (long n = 0; n < nodes; ++n) {
+      double f[3] = {0.0, 0.0, 0.0};
+      for (int g = gather_start_[static_cast<size_t>(n)]; g < gather_start_[static_cast<size_t>(n) + 1]; ++g) {
+        const auto [bi, at] = gather_[static_cast<size_t>(g)];
+        const Batch& b = batches_[static_cast<size_t>(bi)];
+        const size_t lanes = b.point.size();
+        f[0] += b.force[static_cast<size_t>(at)];
+        f[1] += b.force[static_cast<size_t>(at) + lanes];
+        f[2] += b.force[static_cast<size_t>(at) + 2 * lanes];
+      }
+      for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
+    }
+  });
 }
 
 }  // namespace arlequin::continuum

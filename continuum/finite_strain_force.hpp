@@ -11,10 +11,13 @@
 //    calls). Nothing is allocated per call.
 //  - Layout (why a class): the points are grouped into batches of equal node count and material
 //    and stored lane-major (entry k of lane i at k * lanes + i), so that passes over a tile of
-//    lanes compute H, E, S and P of many points at once, vectorised for any node count; their
-//    node forces are then added to f_int in a fixed order. One thread, as the rest of the
-//    continuum's step.
+//    lanes compute H, E, S and P of many points at once, vectorised for any node count. The
+//    tiles run on the OpenMP threads (above parallel_threshold entries), each writing its own
+//    lanes' node forces; then every node sums its entries in one fixed order (batch, lane,
+//    entry: the order of a serial scatter), the nodes split over the threads: the same bits
+//    on any thread count.
 #pragma once
+#include <utility>
 #include <vector>
 
 #include "common/vec3.hpp"
@@ -36,13 +39,18 @@ class FiniteStrainForce {
     std::vector<int> point;             // q of each lane
     std::vector<int> dof;               // [k * lanes + i]: 3 x node of entry k of lane i
     std::vector<double> gx, gy, gz;     // [k * lanes + i]
-    mutable std::vector<double> force;  // one tile, [(3 k + c) * kTile + t]: w_q (P_q grad N_k)_c
+    mutable std::vector<double> force;  // [(3 k + c) * lanes + i]: w_q (P_q grad N_k)_c of lane i
   };
-  // Lanes are computed a tile at a time, so a tile's node forces are still in cache when they
-  // are added to f_int.
+  // Lanes are computed a tile at a time (the tile's H and P stay in registers and cache).
   static constexpr int kTile = 256;
   static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w);
   std::vector<Batch> batches_;
+  std::vector<std::pair<int, int>> tiles_;  // (batch, first lane) of every tile
+  // Node n's entries: gather_[gather_start_[n] .. gather_start_[n + 1]), each (batch, offset of
+  // its x component in the batch's force; y and z follow at + lanes, + 2 lanes).
+  std::vector<int> gather_start_;
+  std::vector<std::pair<int, int>> gather_;
+  long entries_ = 0;
 };
 
 }  // namespace arlequin::continuum

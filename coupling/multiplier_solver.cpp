@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 
 namespace arlequin::coupling {
 
@@ -20,6 +21,35 @@ void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>&
   scratch.array() /= D.array();
   f.matrixU().solveInPlace(scratch);
   x = f.permutationPinv() * scratch;
+}
+
+// out = A x for a row-major A and x of `width` columns stored row after row (a Matrix3, or a
+// vector for width 1): each row's sum in the order of its entries, rows split over the threads
+// when A has enough entries, so the result has the same bits on any thread count.
+template <int width>
+void multiply(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const double* x, double* out) {
+  const auto* start = A.outerIndexPtr();
+  const auto* column = A.innerIndexPtr();
+  const double* value = A.valuePtr();
+  for_each_index(A.rows(), A.nonZeros() > parallel_threshold, [&](long r) {
+    double sum[width] = {};
+    for (auto e = start[r]; e < start[r + 1]; ++e)
+      for (int c = 0; c < width; ++c) sum[c] += value[e] * x[static_cast<std::size_t>(column[e]) * width + c];
+    for (int c = 0; c < width; ++c) out[static_cast<std::size_t>(r) * width + c] = sum[c];
+  });
+}
+
+// out += A x (rows of 3; x's rows `stride` apart).
+void multiply_add(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const double* x, Eigen::Index stride, double* out) {
+  const auto* start = A.outerIndexPtr();
+  const auto* column = A.innerIndexPtr();
+  const double* value = A.valuePtr();
+  for_each_index(A.rows(), A.nonZeros() > parallel_threshold, [&](long r) {
+    double sum[3] = {out[3 * r], out[3 * r + 1], out[3 * r + 2]};
+    for (auto e = start[r]; e < start[r + 1]; ++e)
+      for (int c = 0; c < 3; ++c) sum[c] += value[e] * x[static_cast<std::size_t>(column[e] * stride) + c];
+    for (int c = 0; c < 3; ++c) out[3 * r + c] = sum[c];
+  });
 }
 
 bool is_diagonal(const SparseMatrix& G) {
@@ -62,7 +92,8 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
     }
   a->U.resize(rows, k);
   a->U.setFromTriplets(t.begin(), t.end());
-  Eigen::SparseMatrix<double> K = Eigen::SparseMatrix<double>(a->U.transpose()) * a->inv_D.asDiagonal() * a->U;
+  a->Ut = RowMajorMatrix(a->U.transpose());
+  Eigen::SparseMatrix<double> K = Eigen::SparseMatrix<double>(a->Ut) * a->inv_D.asDiagonal() * a->U;
   for (int j = 0; j < k; ++j) K.coeffRef(j, j) += masses[static_cast<std::size_t>(j)];
   a->K = std::make_unique<Factor>();
   a->K->compute(K);
@@ -74,7 +105,7 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
   y = r;
   solve_low_rank(*a, y);
   Eigen::VectorXd Ay = y.cwiseQuotient(a->inv_D);
-  const Eigen::VectorXd Uty = Eigen::SparseMatrix<double>(a->U.transpose()) * y;
+  const Eigen::VectorXd Uty = a->Ut * y;
   Eigen::VectorXd CUty(k);
   for (int j = 0; j < k; ++j) CUty[j] = Uty[j] / masses[static_cast<std::size_t>(j)];
   Ay += a->U * CUty;
@@ -83,16 +114,18 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
 }
 
 void MultiplierSolver::solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const {
-  column.array() *= a.inv_D.array();                 // y = D^-1 r
-  reduced_.noalias() = a.U.transpose() * column;     // U^T y
+  column.array() *= a.inv_D.array();  // y = D^-1 r
+  reduced_.resize(a.U.cols());
+  multiply<1>(a.Ut, column.data(), reduced_.data());  // U^T y
   solve_with_factor(*a.K, a.K_diagonal, reduced_, reduced_scratch_);
-  solution_.noalias() = a.U * reduced_;              // U K^-1 U^T y
+  solution_.resize(a.U.rows());
+  multiply<1>(a.U, reduced_.data(), solution_.data());  // U K^-1 U^T y
   column.array() -= a.inv_D.array() * solution_.array();
 }
 
 MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
                                    const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc)
-    : ops_(&ops) {
+    : ops_(&ops), GdT_(ops.Gd.transpose()), GcT_(ops.Gc.transpose()) {
   const int np = ops.num_particles(), nn = static_cast<int>(ops.Gc.cols());
   if (static_cast<int>(inv_mass_d.size()) != np || static_cast<int>(inv_mass_c.size()) != 3 * nn)
     throw std::invalid_argument("MultiplierSolver: inverse mass sizes do not match the operators");
@@ -207,16 +240,19 @@ std::string MultiplierSolver::backend() const {
 }
 
 void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const {
-  out.noalias() = ops_->Gd * vd;
-  out.noalias() += ops_->Gc * vc;
+  out.resize(ops_->rows(), 3);
+  multiply<3>(ops_->Gd, vd.data(), out.data());
+  multiply_add(ops_->Gc, vc.data(), vc.outerStride(), out.data());
 }
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
   solve(rhs_, lambda);
-  dd.noalias() = ops_->Gd.transpose() * lambda;
+  dd.resize(GdT_.rows(), 3);
+  multiply<3>(GdT_, lambda.data(), dd.data());
   dd.array() *= inv_d_.array();
-  dc.noalias() = ops_->Gc.transpose() * lambda;
+  dc.resize(GcT_.rows(), 3);
+  multiply<3>(GcT_, lambda.data(), dc.data());
   dc.array() *= inv_c_.array();
   vd -= dd;
   vc -= dc;

@@ -80,9 +80,10 @@ class MultiplierSolver {
  private:
   using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
   // The Woodbury form of one component's A (above).
+  using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct LowRank {
     Eigen::VectorXd inv_D;            // per row
-    Eigen::SparseMatrix<double> U;    // rows x reached dofs of the component
+    RowMajorMatrix U, Ut;             // rows x reached dofs of the component, and its transpose
     std::unique_ptr<Factor> K;
     Eigen::VectorXd K_diagonal;
   };
@@ -92,6 +93,7 @@ class MultiplierSolver {
   void solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const;
 
   const CouplingOperators* ops_;
+  RowMajorMatrix GdT_, GcT_;                   // the transposes, for row-wise products
   std::vector<std::unique_ptr<LowRank>> low_rank_;  // one per system, or empty
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
   std::vector<std::unique_ptr<Factor>> factors_;  // our LDL^T, or
