@@ -625,6 +625,8 @@ VirtualTestResult run_virtual_test(const std::filesystem::path& case_file, const
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.particles = scene.dem.particles.size();
   r.bonds = bond_count(scene.dem);
+  if (scene.weave && !load.shear() && load.face < 2)
+    r.rule_of_mixtures = load.face == 0 ? scene.weave->rule_of_mixtures_x : scene.weave->rule_of_mixtures_y;
   r.steps = run.steps;
   r.dt = scene.dt;
   r.kinetic_to_bond = run.energies.kinetic / run.energies.bond;
@@ -863,6 +865,7 @@ namespace {
 std::string describe_result(const VirtualTestResult& r) {
   std::string line = r.load.shear() ? "G" : "E";
   line += format(" = %.5g", r.modulus.value * 1e-9) + format(" ± %.2g GPa", r.modulus.uncertainty * 1e-9);
+  if (!std::isnan(r.rule_of_mixtures)) line += format(" (the weave's rule of mixtures %.4g GPa)", r.rule_of_mixtures * 1e-9);
   for (int k = 0; k < 3; ++k)
     if (!std::isnan(r.poisson[k].value))
       line += ", nu_" + std::string(axis_names[r.load.face]) + std::string(axis_names[k]) + format(" %.4f", r.poisson[k].value) +

@@ -93,6 +93,8 @@ struct VirtualTestResult {
   Estimate stress;    // Pa: sigma_aa on the moved face (tension), tau_nd (shear)
   Estimate strain;    // measured between the loaded slabs: eps_aa, or the shear angle gamma_nd
   Estimate modulus;   // stress / strain: E_a, or the apparent G_nd
+  // A weave's tension along x or y: its rule of mixtures (dem::WeaveReport), Pa; NaN otherwise.
+  double rule_of_mixtures = std::numeric_limits<double>::quiet_NaN();
   std::array<Estimate, 3> lateral_strain;  // tension: eps_kk of the free axes k; NaN otherwise
   std::array<Estimate, 3> poisson;         // tension: nu_ak = -eps_kk / eps_aa; NaN otherwise
   double force_imbalance = 0.0;  // |F_moved + F_held| / |F_moved| averaged: distance from equilibrium

@@ -316,6 +316,8 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s, const std::function
   report.areal_density = report.mass / (s.length_x * s.length_y);
   report.fibre_volume_fraction = s.section * total_length / (s.length_x * s.length_y * report.thickness);
   report.spring_stiffness = EA / (2.0 * g.R);
+  report.rule_of_mixtures_x = s.modulus * s.section * s.weft_layers / (s.weft_spacing * report.thickness);
+  report.rule_of_mixtures_y = s.modulus * s.section * (s.weft_layers - 1) / (s.warp_spacing * report.thickness);
   report.des = std::size_t(std::count_if(id.begin(), id.end(), [](std::uint32_t i) { return i != not_kept; }));
   report.des_not_kept = draft.x.size() - report.des;
   return report;

@@ -72,6 +72,10 @@ struct WeaveReport {
   std::size_t des = 0, springs = 0;
   std::size_t des_not_kept = 0;                    // refused by build_weave's keep
   double deepest_overlap = 0.0;                    // over 2R, of two DEs not joined by a spring
+  // Rule of mixtures of the in-plane moduli over the thickness above, per pitch: E S times the
+  // yarns per unit width, E_x the weft's (K per weft column), E_y the stuffers' (K - 1 per
+  // column; the crimped binders carry nothing at small strain), Pa.
+  double rule_of_mixtures_x = 0.0, rule_of_mixtures_y = 0.0;
 };
 
 // A spec field (by its case-file name) that makes the weave impossible, and why.

@@ -83,6 +83,9 @@ TEST(Weave, CountsLengthsMassAndArealDensityMatchTheClosedForms) {
   EXPECT_NEAR(r.areal_density / (closed / (6e-3 * 8e-3)), 1.0, 1e-4);
   EXPECT_NEAR(r.thickness, 2 * r.amplitude + s.yarn_thickness, 1e-15);
   EXPECT_NEAR(r.fibre_volume_fraction * 6e-3 * 8e-3 * r.thickness / (s.section * (12 * 6e-3 + 6 * 8e-3 + 2 * Lb)), 1.0, 1e-4);
+  // Rule of mixtures per pitch: K weft yarns per weft column, K - 1 stuffers per stuffer column.
+  EXPECT_NEAR(r.rule_of_mixtures_x * s.weft_spacing * r.thickness / (s.modulus * s.section * s.weft_layers), 1.0, 1e-12);
+  EXPECT_NEAR(r.rule_of_mixtures_y * s.warp_spacing * r.thickness / (s.modulus * s.section * (s.weft_layers - 1)), 1.0, 1e-12);
 
   // Seed Eq. 8: a weft chain has n_s = 20 springs of 0.3 mm: K = (n_s / n_p) E S / L_y.
   const auto& weft = dynamic_cast<const SpringBondSet&>(*model.bond_sets()[0]);
