@@ -322,6 +322,7 @@ void CoupledModel::save_state(StateArchive& archive) const {
   archive.put("coupling/time", time_);
   archive.put("coupling/steps", std::int64_t{steps_});
   archive.put("coupling/breaks_looked_at", static_cast<std::int64_t>(breaks_looked_at_));
+  archive.put("coupling/held_looked_at", static_cast<std::int64_t>(held_looked_at_));
 }
 
 void CoupledModel::load_state(const StateArchive& archive) {
@@ -341,6 +342,7 @@ void CoupledModel::load_state(const StateArchive& archive) {
   time_ = archive.number("coupling/time");
   steps_ = archive.integer("coupling/steps");
   breaks_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/breaks_looked_at"));
+  held_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/held_looked_at"));
 }
 
 Matrix3 CoupledModel::dem_coupling_force() const { return -(ops_.Gd.transpose() * mu_); }

@@ -165,7 +165,6 @@ class CoupledModel {
   // The breaks since the last call whose bonds lie where the DEM's weight is below 1 (count and
   // first; nullopt if none): each break of the DEM is looked at once. With
   // hold_overlap_failures, the bonds held intact there instead (held).
-  // A restart lists the held bonds again (which ones are held is not in the checkpoint).
   std::optional<OverlapDamage> damage_in_overlap();
 
   // Checkpoint (docs/restart.md): both models' states (DemModel::save_state,

@@ -23,32 +23,18 @@ void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>&
   x = f.permutationPinv() * scratch;
 }
 
-// out = A x for a row-major A and x of `width` columns stored row after row (a Matrix3, or a
-// vector for width 1): each row's sum in the order of its entries, rows split over the threads
-// when A has enough entries, so the result has the same bits on any thread count.
+// out = A x for a row-major A and x of `width` columns whose rows lie `stride` apart (a Matrix3,
+// or a vector for width 1); out += A x with `add`. Each row's sum in the order of its entries,
+// rows split over the threads when A has enough entries: the same bits on any thread count.
 template <int width>
-void multiply(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const double* x, double* out) {
-  const auto* start = A.outerIndexPtr();
-  const auto* column = A.innerIndexPtr();
-  const double* value = A.valuePtr();
+void multiply(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const double* x, Eigen::Index stride, double* out,
+              bool add = false) {
   for_each_index(A.rows(), A.nonZeros() > parallel_threshold, [&](long r) {
-    double sum[width] = {};
-    for (auto e = start[r]; e < start[r + 1]; ++e)
-      for (int c = 0; c < width; ++c) sum[c] += value[e] * x[static_cast<std::size_t>(column[e]) * width + c];
-    for (int c = 0; c < width; ++c) out[static_cast<std::size_t>(r) * width + c] = sum[c];
-  });
-}
-
-// out += A x (rows of 3; x's rows `stride` apart).
-void multiply_add(const Eigen::SparseMatrix<double, Eigen::RowMajor>& A, const double* x, Eigen::Index stride, double* out) {
-  const auto* start = A.outerIndexPtr();
-  const auto* column = A.innerIndexPtr();
-  const double* value = A.valuePtr();
-  for_each_index(A.rows(), A.nonZeros() > parallel_threshold, [&](long r) {
-    double sum[3] = {out[3 * r], out[3 * r + 1], out[3 * r + 2]};
-    for (auto e = start[r]; e < start[r + 1]; ++e)
-      for (int c = 0; c < 3; ++c) sum[c] += value[e] * x[static_cast<std::size_t>(column[e] * stride) + c];
-    for (int c = 0; c < 3; ++c) out[3 * r + c] = sum[c];
+    double sum[width];
+    for (int c = 0; c < width; ++c) sum[c] = add ? out[r * width + c] : 0.0;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(A, r); it; ++it)
+      for (int c = 0; c < width; ++c) sum[c] += it.value() * x[it.col() * stride + c];
+    for (int c = 0; c < width; ++c) out[r * width + c] = sum[c];
   });
 }
 
@@ -116,11 +102,17 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
 void MultiplierSolver::solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const {
   column.array() *= a.inv_D.array();  // y = D^-1 r
   reduced_.resize(a.U.cols());
-  multiply<1>(a.Ut, column.data(), reduced_.data());  // U^T y
+  multiply<1>(a.Ut, column.data(), 1, reduced_.data());  // U^T y
   solve_with_factor(*a.K, a.K_diagonal, reduced_, reduced_scratch_);
   solution_.resize(a.U.rows());
-  multiply<1>(a.U, reduced_.data(), solution_.data());  // U K^-1 U^T y
+  multiply<1>(a.U, reduced_.data(), 1, solution_.data());  // U K^-1 U^T y
   column.array() -= a.inv_D.array() * solution_.array();
+}
+
+int MultiplierSolver::system_of_earlier_component(int c) const {
+  for (int b = 0; b < c; ++b)
+    if (inv_c_.col(b) == inv_c_.col(c)) return factor_of_[b];
+  return -1;
 }
 
 MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
@@ -136,10 +128,7 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
   // The low-rank form when every distinct component has it; else the general factor.
   if (!petsc) {
     for (int c = 0; c < 3; ++c) {
-      int same = -1;
-      for (int b = 0; b < c && same < 0; ++b)
-        if (inv_c_.col(b) == inv_c_.col(c)) same = factor_of_[b];
-      if (same >= 0) {
+      if (const int same = system_of_earlier_component(c); same >= 0) {
         factor_of_[c] = same;
         continue;
       }
@@ -155,10 +144,7 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
     if (!low_rank_.empty()) return;
   }
   for (int c = 0; c < 3; ++c) {
-    int same = -1;
-    for (int b = 0; b < c && same < 0; ++b)
-      if (inv_c_.col(b) == inv_c_.col(c)) same = factor_of_[b];
-    if (same >= 0) {
+    if (const int same = system_of_earlier_component(c); same >= 0) {
       factor_of_[c] = same;
       continue;
     }
@@ -241,18 +227,18 @@ std::string MultiplierSolver::backend() const {
 
 void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const {
   out.resize(ops_->rows(), 3);
-  multiply<3>(ops_->Gd, vd.data(), out.data());
-  multiply_add(ops_->Gc, vc.data(), vc.outerStride(), out.data());
+  multiply<3>(ops_->Gd, vd.data(), 3, out.data());
+  multiply<3>(ops_->Gc, vc.data(), vc.outerStride(), out.data(), true);
 }
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
   solve(rhs_, lambda);
   dd.resize(GdT_.rows(), 3);
-  multiply<3>(GdT_, lambda.data(), dd.data());
+  multiply<3>(GdT_, lambda.data(), 3, dd.data());
   dd.array() *= inv_d_.array();
   dc.resize(GcT_.rows(), 3);
-  multiply<3>(GcT_, lambda.data(), dc.data());
+  multiply<3>(GcT_, lambda.data(), 3, dc.data());
   dc.array() *= inv_c_.array();
   vd -= dd;
   vc -= dc;

@@ -91,6 +91,9 @@ class MultiplierSolver {
   // set-up residual check fails.
   std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc) const;
   void solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const;
+  // The system of an earlier component with the same continuum inverse masses (the DEs' are the
+  // same for all three components), or -1.
+  int system_of_earlier_component(int c) const;
 
   const CouplingOperators* ops_;
   RowMajorMatrix GdT_, GcT_;                   // the transposes, for row-wise products

@@ -642,6 +642,41 @@ void DemModel::check_energy(double energy_limit) const {
   throw RunError(msg.str());
 }
 
+void DemModel::save_events(StateArchive& archive, const std::string& prefix, const std::vector<BreakEvent>& events) {
+  std::vector<double> time, stress, energy, mode_mix;
+  std::vector<std::uint32_t> set, bond, criterion, mode;
+  for (const BreakEvent& e : events) {
+    time.push_back(e.time), stress.push_back(e.stress), energy.push_back(e.energy), mode_mix.push_back(e.mode_mix);
+    set.push_back(e.set), bond.push_back(e.bond);
+    criterion.push_back(static_cast<std::uint32_t>(e.criterion)), mode.push_back(static_cast<std::uint32_t>(e.mode));
+  }
+  for (const auto& [name, values] : {std::pair{"time", &time}, {"stress", &stress}, {"energy", &energy}, {"mode_mix", &mode_mix}})
+    archive.put(prefix + name, *values);
+  for (const auto& [name, values] : {std::pair{"set", &set}, {"bond", &bond}, {"criterion", &criterion}, {"mode", &mode}})
+    archive.put(prefix + name, *values);
+}
+
+std::vector<BreakEvent> DemModel::load_events(const StateArchive& archive, const std::string& prefix,
+                                              const std::function<bool(const BreakEvent&)>& consistent, const char* what) const {
+  const auto time = archive.get<double>(prefix + "time"), stress = archive.get<double>(prefix + "stress"),
+             energy = archive.get<double>(prefix + "energy"), mode_mix = archive.get<double>(prefix + "mode_mix");
+  const auto set = archive.get<std::uint32_t>(prefix + "set"), bond = archive.get<std::uint32_t>(prefix + "bond"),
+             criterion = archive.get<std::uint32_t>(prefix + "criterion"), mode = archive.get<std::uint32_t>(prefix + "mode");
+  const std::size_t n = time.size();
+  for (const std::size_t size : {stress.size(), energy.size(), mode_mix.size(), set.size(), bond.size(), criterion.size(), mode.size()})
+    if (size != n) throw StateMismatch("its break records have columns of different lengths");
+  std::vector<BreakEvent> events;
+  for (std::size_t k = 0; k < n; ++k) {
+    const BreakEvent e{time[k], set[k], bond[k], static_cast<FailureCriterion>(criterion[k]), static_cast<FailureMode>(mode[k]),
+                       stress[k], energy[k], mode_mix[k]};
+    if (set[k] >= bond_sets_.size() || bond[k] >= bond_sets_[set[k]]->size() || !consistent(e) ||
+        criterion[k] > static_cast<std::uint32_t>(FailureCriterion::cohesive) || mode[k] > static_cast<std::uint32_t>(FailureMode::torsion))
+      throw StateMismatch("its break record " + std::to_string(k) + " names a bond this scene does not have " + what);
+    events.push_back(e);
+  }
+  return events;
+}
+
 void DemModel::save_state(StateArchive& archive) const {
   const ParticleSet& p = particles;
   for (const auto& [name, values] : {std::pair{"reference", &p.reference}, {"position", &p.position}, {"velocity", &p.velocity},
@@ -652,17 +687,8 @@ void DemModel::save_state(StateArchive& archive) const {
   archive.put("dem/particles/inv_mass", p.inv_mass);
   for (std::size_t s = 0; s < bond_sets_.size(); ++s) bond_sets_[s]->save_state(archive, "dem/bonds/" + std::to_string(s) + "/");
   if (neighbours_) neighbours_->save_state(archive, "dem/neighbours/");
-  std::vector<double> time, stress, energy, mode_mix;
-  std::vector<std::uint32_t> set, bond, criterion, mode;
-  for (const BreakEvent& e : breaks_) {
-    time.push_back(e.time), stress.push_back(e.stress), energy.push_back(e.energy), mode_mix.push_back(e.mode_mix);
-    set.push_back(e.set), bond.push_back(e.bond);
-    criterion.push_back(static_cast<std::uint32_t>(e.criterion)), mode.push_back(static_cast<std::uint32_t>(e.mode));
-  }
-  for (const auto& [name, values] : {std::pair{"time", &time}, {"stress", &stress}, {"energy", &energy}, {"mode_mix", &mode_mix}})
-    archive.put("dem/breaks/" + std::string(name), *values);
-  for (const auto& [name, values] : {std::pair{"set", &set}, {"bond", &bond}, {"criterion", &criterion}, {"mode", &mode}})
-    archive.put("dem/breaks/" + std::string(name), *values);
+  save_events(archive, "dem/breaks/", breaks_);
+  if (!held_.empty()) save_events(archive, "dem/held_failures/", held_failures_);
   archive.put("dem/constraint_reaction", constraint_reaction_);
   archive.put("dem/damping_force", damping_force_);
   archive.put("dem/damping_torque", damping_torque_);
@@ -696,20 +722,13 @@ void DemModel::load_state(const StateArchive& archive) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->load_state(archive, "dem/neighbours/", p.size());
   }
-  const auto time = archive.get<double>("dem/breaks/time"), stress = archive.get<double>("dem/breaks/stress"),
-             energy = archive.get<double>("dem/breaks/energy"), mode_mix = archive.get<double>("dem/breaks/mode_mix");
-  const auto set = archive.get<std::uint32_t>("dem/breaks/set"), bond = archive.get<std::uint32_t>("dem/breaks/bond"),
-             criterion = archive.get<std::uint32_t>("dem/breaks/criterion"), mode = archive.get<std::uint32_t>("dem/breaks/mode");
-  const std::size_t n = time.size();
-  for (const std::size_t size : {stress.size(), energy.size(), mode_mix.size(), set.size(), bond.size(), criterion.size(), mode.size()})
-    if (size != n) throw StateMismatch("its break records have columns of different lengths");
-  breaks_.clear();
-  for (std::size_t k = 0; k < n; ++k) {
-    if (set[k] >= bond_sets_.size() || bond[k] >= bond_sets_[set[k]]->size() || !bond_sets_[set[k]]->broken()[bond[k]] ||
-        criterion[k] > static_cast<std::uint32_t>(FailureCriterion::cohesive) || mode[k] > static_cast<std::uint32_t>(FailureMode::torsion))
-      throw StateMismatch("its break record " + std::to_string(k) + " names a bond this scene does not have broken");
-    breaks_.push_back({time[k], set[k], bond[k], static_cast<FailureCriterion>(criterion[k]), static_cast<FailureMode>(mode[k]),
-                       stress[k], energy[k], mode_mix[k]});
+  breaks_ = load_events(archive, "dem/breaks/", [this](const BreakEvent& e) { return bond_sets_[e.set]->broken()[e.bond] != 0; },
+                        "broken");
+  if (!held_.empty()) {
+    held_failures_ = load_events(archive, "dem/held_failures/",
+                                 [this](const BreakEvent& e) { return !bond_sets_[e.set]->broken()[e.bond] && held_[e.set][e.bond] != 0; },
+                                 "held");
+    for (const BreakEvent& e : held_failures_) held_[e.set][e.bond] = 2;
   }
   archive.get_into("dem/constraint_reaction", constraint_reaction_);
   archive.get_into("dem/damping_force", damping_force_);

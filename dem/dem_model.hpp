@@ -106,7 +106,8 @@ class DemModel {
   // Bonds whose failure criterion is held in abeyance (a coupling overlap, where the continuum
   // cannot break: coupling.on_damage_in_overlap: hold): held(set, bond) true keeps the bond intact
   // when its criterion is met; each such bond is listed once in held_failures(), as the break it
-  // would have been. After finalize() (which orders the bonds), before the first step.
+  // would have been. After finalize() (which orders the bonds), before the first step; a
+  // checkpoint keeps the list (and load_state needs the same bonds held).
   void hold_failures(const std::function<bool(std::size_t set, std::size_t bond)>& held);
   const std::vector<BreakEvent>& held_failures() const { return held_failures_; }
   bool failure_enabled() const { return failure_on_; }
@@ -168,6 +169,11 @@ class DemModel {
     std::size_t crowded = 0;      // that DE
   };
   void check_contact_resolution(const ContactResolution& worst) const;
+  // Break records under `prefix` of a checkpoint (breaks, held failures); load_events checks each
+  // against this scene (StateMismatch naming `what` the bond should be, unless consistent(e)).
+  static void save_events(StateArchive& archive, const std::string& prefix, const std::vector<BreakEvent>& events);
+  std::vector<BreakEvent> load_events(const StateArchive& archive, const std::string& prefix,
+                                      const std::function<bool(const BreakEvent&)>& consistent, const char* what) const;
   // DE i's row of the frequency bound (1/s^2) from `contacts` contacts (critical_time_step).
   double contact_frequency_bound(std::size_t i, std::uint32_t contacts) const;
   // alpha_i / m_i: a weighted contact's stiffness over a DE's weighted mass is at most

@@ -68,10 +68,7 @@ def main(argv):
     for r in rows:
         print(f"| {r['run']} | {r['des']} | {r['steps']} | {r['wall_s']:.1f} | {r['max_dv_over_v0']:.4f} | {r['v_end']:.2f} | "
               f"{r['first_break_us']:.1f} | {r['fracture_J']:.4f} | {r['worst_balance_J']:.2e} |")
-    with open(sweep_dir / "convergence.csv", "w") as out:
-        out.write(",".join(rows[0].keys()) + "\n")
-        for r in rows:
-            out.write(",".join(str(v) for v in r.values()) + "\n")
+    arlequin.write_table(sweep_dir / "convergence.csv", rows)
 
     import matplotlib
     matplotlib.use("Agg")

@@ -77,10 +77,7 @@ def main(argv):
         print(f"| {r['run']} | {r['des']} | {r['nodes']} | {r['wall_s']:.1f} | {rows[0]['wall_s'] / r['wall_s']:.2f}x | "
               f"{100 * r['velocity_max_rel']:.2f} % | {100 * r['peak_force_rel']:+.1f} % | {100 * r['first_break_rel']:+.1f} % | "
               f"{r['fracture_J']:.4f} | {r['balance_rel']:.1e} |")
-    with open(sweep_dir / "patch_sweep.csv", "w") as out:
-        out.write(",".join(rows[0].keys()) + "\n")
-        for r in rows:
-            out.write(",".join(str(v) for v in r.values()) + "\n")
+    arlequin.write_table(sweep_dir / "patch_sweep.csv", rows)
 
     import matplotlib
     matplotlib.use("Agg")

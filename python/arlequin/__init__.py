@@ -6,6 +6,6 @@ draws the plots that the C++ program describes in DIR/plots.json. Importing this
 is cheap: numpy, pandas, h5py and matplotlib are imported only when first needed.
 """
 
-from .results import Run, load
+from .results import Run, load, write_table
 
-__all__ = ["Run", "load"]
+__all__ = ["Run", "load", "write_table"]

@@ -73,3 +73,12 @@ class Run:
 def load(path):
     """The results folder at `path` as a Run; FileNotFoundError if it is not a folder."""
     return Run(path)
+
+
+def write_table(path, rows):
+    """Rows (dicts with the same keys, in order) as a CSV file at `path`: the keys as its header."""
+    with open(path, "w") as out:
+        out.write(",".join(rows[0].keys()) + "\n")
+        for r in rows:
+            out.write(",".join(str(v) for v in r.values()) + "\n")
+

@@ -96,6 +96,9 @@ TEST_P(Restart, HalfWayCheckpointContinuesToTheSameBits) {
   // uninterrupted one did (and lists its pairs in the same order).
   EXPECT_EQ(summary["counts"], reference["counts"]);
   EXPECT_EQ(summary["energies"], reference["energies"]);
+  if (reference.contains("damage_in_overlap_breaks")) {  // each held or broken bond of the overlap counted once
+    EXPECT_EQ(summary["damage_in_overlap_breaks"], reference["damage_in_overlap_breaks"]);
+  }
   EXPECT_EQ(summary["restarted_at_step"].get<long>(), steps / 2);
   EXPECT_EQ(summary["status"], "completed");
 }
@@ -108,6 +111,8 @@ std::vector<RestartCase> restart_cases() {
       {"Contact", "cases/demo_beam_impact/case.yaml", "an impact's contacts and the neighbour list"}};
 #ifdef ARLEQUIN_WITH_CONTINUUM
   cases.push_back({"Coupled", "cases/wave_bar_coupled/case.yaml", "the continuum's fields and the coupling's multipliers"});
+  cases.push_back({"CoupledFabric", "cases/fabric_impact_coupled/reduced.yaml",
+                   "a weave's contacts weighted in the overlap, breaks, the overlap's springs held at their criterion"});
 #endif
   return cases;
 }
