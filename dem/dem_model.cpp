@@ -554,24 +554,37 @@ Vec3 DemModel::mean_velocity(int group) const {
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-  const PhaseTimer timer(profile_, phase_.finite, !contact_ && particle_loops_threaded());
-  // Without contact only non-finite velocities count: a count on the threads, split as the
-  // kicks, and the serial pass below only to name the first of them.
-  if (!contact_ && fixed_order_sum(n, parallel_threshold, check_partial_, [&p](long i) {
-        return is_finite(p.velocity[i]) && is_finite(p.angular_velocity[i]) ? 0.0 : 1.0;
-      }) == 0.0)
-    return;
+  const PhaseTimer timer(profile_, phase_.finite, particle_loops_threaded());
+  // Chunks of DEs on the threads, split as the kicks, each finding its non-finite velocities and,
+  // with contact, its fastest and most crowded DE (the first of equals); the chunks are then taken
+  // in order with the same strict comparisons, so the DEs named are the serial pass's.
+  constexpr long chunk = 256;
+  const long chunks = (n + chunk - 1) / chunk;
+  if (static_cast<long>(finite_chunks_.size()) < chunks) finite_chunks_.resize(static_cast<std::size_t>(chunks));
+  for_each_index(chunks, n > parallel_threshold, [&](long c) {
+    FiniteScan scan;
+    for (long k = c * chunk, end = std::min(n, (c + 1) * chunk); k < end; ++k) {
+      const auto i = static_cast<std::size_t>(k);
+      if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
+        if (scan.bad++ == 0) scan.first = i;
+      }
+      if (!contact_) continue;
+      ContactResolution& worst = scan.worst;
+      if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
+      if (touching_[i] > 0)
+        if (const double row = bond_frequency_bound_[i] + contact_frequency_bound(i, touching_[i]); row > worst.omega2)
+          worst.omega2 = row, worst.crowded = i;
+    }
+    finite_chunks_[static_cast<std::size_t>(c)] = scan;
+  });
   std::size_t bad = 0, first = 0;
   ContactResolution worst;  // with contact
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
-      if (bad++ == 0) first = i;
-    }
-    if (!contact_) continue;
-    if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
-    if (touching_[i] > 0)
-      if (const double row = bond_frequency_bound_[i] + contact_frequency_bound(i, touching_[i]); row > worst.omega2)
-        worst.omega2 = row, worst.crowded = i;
+  for (long c = 0; c < chunks; ++c) {
+    const FiniteScan& scan = finite_chunks_[static_cast<std::size_t>(c)];
+    if (scan.bad > 0 && bad == 0) first = scan.first;
+    bad += scan.bad;
+    if (scan.worst.reach > worst.reach) worst.reach = scan.worst.reach, worst.fastest = scan.worst.fastest;
+    if (scan.worst.omega2 > worst.omega2) worst.omega2 = scan.worst.omega2, worst.crowded = scan.worst.crowded;
   }
   if (bad == 0 && contact_) check_contact_resolution(worst);
   if (bad == 0) return;

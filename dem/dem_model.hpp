@@ -225,7 +225,12 @@ class DemModel {
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
-  mutable std::vector<double> check_partial_;  // scratch: check_finite's chunk counts
+  // check_finite's scan of one chunk of DEs.
+  struct FiniteScan {
+    ContactResolution worst;
+    std::size_t bad = 0, first = 0;  // non-finite velocities, the first of them
+  };
+  mutable std::vector<FiniteScan> finite_chunks_;  // scratch: check_finite's chunks
   bool energy_record_requested_ = false;  // record_energies_in_next_step()
   long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
   mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE

@@ -97,6 +97,7 @@ void NeighbourList::build(const ParticleSet& p) {
       const std::int64_t cx = c / (ny * nz), cy = c / nz % ny, cz = c % nz;
       const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
       const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
+      if (begin == end) continue;  // most cells of a sparse scene
       for (const std::uint32_t* a = begin; a != end; ++a)
         for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b, out);
       for (std::int64_t dx = -1; dx <= 1; ++dx)
