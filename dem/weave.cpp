@@ -261,6 +261,7 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s, const std::function
   ParticleSet& p = model.particles;
   constexpr std::uint32_t not_kept = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> id(draft.x.size(), not_kept);
+  p.reserve(p.size() + draft.x.size());
   const double de_volume = 4.0 / 3.0 * pi * g.R * g.R * g.R;
   for (const Yarn& y : yarns) {
     const double yarn_mass = s.density * s.section * y.length;

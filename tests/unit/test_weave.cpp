@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The 3D-interlock builder (dem/weave.hpp) against the closed forms of its geometry
 // (docs/theory.md#weave): yarn counts, DEs per chain, lengths, mass and areal density,
-// spring stiffness; no interpenetration; impossible weaves refused by the field at fault.
+// spring stiffness; no interpenetration; a coupled scene's patch is the whole weave's part there;
+// impossible weaves refused by the field at fault.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
+#include <set>
 
 #include "dem/bonds/spring_bond.hpp"
 #include "dem/weave.hpp"
@@ -138,6 +140,44 @@ TEST(Weave, YarnsDoNotInterpenetrateAndTheDefaultCrimpIsTheSmallestThatClears) {
   s.crimp = 1.1 * r.crimp;
   DemModel steeper;
   EXPECT_NEAR(build_weave(steeper, s).crimp, s.crimp, 1e-6);
+}
+
+// A coupled scene's patch (keep: x < 2.5 mm): the DEs created are the full weave's DEs there,
+// at the same places and with the same masses; every spring joins two of them and is one of the
+// full weave's; every group holds only them; the report's yarn figures stay the whole fabric's.
+TEST(Weave, AKeptPatchIsThePartOfTheWholeWeaveItCovers) {
+  const WeaveSpec s = small_weave();
+  DemModel whole, patch;
+  const WeaveReport all = build_weave(whole, s);
+  const auto inside = [](const Vec3& x) { return x.x < 2.5e-3; };
+  const WeaveReport kept = build_weave(patch, s, inside);
+  std::vector<std::size_t> of_whole;  // the whole weave's index of each kept DE, in order
+  for (std::size_t i = 0; i < whole.particles.size(); ++i)
+    if (inside(whole.particles.position[i])) of_whole.push_back(i);
+  ASSERT_EQ(patch.particles.size(), of_whole.size());
+  ASSERT_GT(of_whole.size(), 100u);
+  EXPECT_LT(of_whole.size(), whole.particles.size());
+  EXPECT_EQ(kept.des, of_whole.size());
+  EXPECT_EQ(kept.des_not_kept, all.des - kept.des);
+  for (std::size_t k = 0; k < of_whole.size(); ++k) {
+    EXPECT_EQ(patch.particles.position[k], whole.particles.position[of_whole[k]]);
+    EXPECT_EQ(patch.particles.mass(k), whole.particles.mass(of_whole[k]));
+  }
+  std::set<std::pair<std::size_t, std::size_t>> whole_springs;
+  for (const auto& set : whole.bond_sets())
+    for (std::size_t b = 0; b < set->size(); ++b) whole_springs.insert({set->first()[b], set->second()[b]});
+  std::size_t springs = 0;
+  for (const auto& set : patch.bond_sets())
+    for (std::size_t b = 0; b < set->size(); ++b, ++springs)
+      EXPECT_TRUE(whole_springs.count({of_whole[set->first()[b]], of_whole[set->second()[b]]}));
+  std::size_t expected = 0;  // the whole weave's springs between two kept DEs
+  for (const auto& [i, j] : whole_springs) expected += inside(whole.particles.position[i]) && inside(whole.particles.position[j]);
+  EXPECT_EQ(springs, expected);
+  EXPECT_EQ(kept.springs, expected);
+  for (const char* family : {"weft", "stuffer", "binder", "edges"})
+    for (std::uint32_t i : patch.members(patch.group_index(family))) EXPECT_LT(i, patch.particles.size());
+  EXPECT_EQ(kept.wefts, all.wefts);
+  EXPECT_DOUBLE_EQ(kept.areal_density, all.areal_density);
 }
 
 TEST(Weave, ImpossibleWeavesNameTheFieldAtFault) {
