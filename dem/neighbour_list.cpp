@@ -118,10 +118,19 @@ void NeighbourList::build(const ParticleSet& p) {
 
 bool NeighbourList::needs_rebuild(const ParticleSet& p) const {
   if (position_at_build_.size() != p.size()) return true;
-  const double limit = 0.25 * skin_ * skin_;
-  for (std::size_t i = 0; i < p.size(); ++i)
-    if (norm2(p.position[i] - position_at_build_[i]) > limit) return true;
-  return false;
+  // A pair left out had a gap of at least the skin at the build; since then it closed by at most
+  // the sum of the two DEs' displacements, so at most the sum of the two largest.
+  double first = 0.0, second = 0.0;  // the two largest squared displacements
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double d2 = norm2(p.position[i] - position_at_build_[i]);
+    if (d2 > first) {
+      second = first;
+      first = d2;
+    } else if (d2 > second) {
+      second = d2;
+    }
+  }
+  return std::sqrt(first) + std::sqrt(second) > skin_;
 }
 
 void NeighbourList::save_state(StateArchive& archive, const std::string& prefix) const {

@@ -2,8 +2,9 @@
 // Verlet list of candidate contact pairs, built from a cell list with a skin.
 //
 // Contract: after build(), pairs() holds every pair i < j, not excluded, whose surfaces are
-// closer than `skin` (|x_i - x_j| < R_i + R_j + skin). The list stays valid while no DE has
-// moved more than skin/2 since the build; needs_rebuild() checks exactly that.
+// closer than `skin` (|x_i - x_j| < R_i + R_j + skin). The list stays valid while the two
+// largest displacements since the build add up to at most the skin (no pair left out can have
+// closed its gap); needs_rebuild() checks exactly that.
 #pragma once
 #include <cstdint>
 #include <span>
