@@ -34,6 +34,9 @@ struct Run {
   bool has(const std::string& name_) const { return std::find(columns.begin(), columns.end(), name_) != columns.end(); }
   // The last row's value of a column, 0 where the run has no such column (a pure DEM's continuum).
   double last(const std::string& name_) const { return has(name_) && !rows.empty() ? column(name_).back() : 0.0; }
+  // Energies at the end, J.
+  double dem_energy() const { return last("E_kinetic") + last("E_bond") + last("E_contact"); }
+  double continuum_energy() const { return last("C_kinetic") + last("C_strain"); }
   std::vector<double> column(const std::string& name_) const {
     const std::size_t c = std::find(columns.begin(), columns.end(), name_) - columns.begin();
     std::vector<double> out;
@@ -124,8 +127,8 @@ Json describe_run(const Run& r) {
   j["checks_passed"] = r.checks_passed;
   if (r.first_break) j["first_break_time"] = *r.first_break;
   Json energy = Json::object();
-  energy["dem"] = r.last("E_kinetic") + r.last("E_bond") + r.last("E_contact");
-  energy["continuum"] = r.last("C_kinetic") + r.last("C_strain");
+  energy["dem"] = r.dem_energy();
+  energy["continuum"] = r.continuum_energy();
   energy["fracture"] = r.last("E_fracture");
   j["energy_at_end"] = energy;
   return j;
@@ -199,9 +202,8 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
               b.particles, b.nodes, b.steps, b.compute_seconds(), b.setup, b.output);
   std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
   for (const Run* r : {&a, &b}) {
-    std::printf("%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(),
-                r->last("E_kinetic") + r->last("E_bond") + r->last("E_contact"), r->last("C_kinetic") + r->last("C_strain"),
-                r->last("E_fracture"));
+    std::printf("%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(), r->dem_energy(),
+                r->continuum_energy(), r->last("E_fracture"));
     if (r->first_break) std::printf("; first break at %.4g s", *r->first_break);
     std::printf("\n");
   }

@@ -79,21 +79,30 @@ void for_each_index(long n, bool threaded, Body&& body) {
   });
 }
 
-// sum over i < n of term(i), each term evaluated once (it may update state of item i): fixed
-// chunks of items are summed, on threads when n > threshold, then the chunks' sums are added
-// in order, so the result has the same bits on any thread count (an OpenMP reduction's does
-// not). `partial` holds the chunks' sums; it grows once and is reused (no allocation per call).
-// The chunk is small enough that a scene just above the threshold (the 10k REV) gives 16
-// threads several chunks each: the half kicks of a damped scene run through here.
-template <class Term>
-double fixed_order_sum(long n, long threshold, std::vector<double>& partial, Term&& term) {
+// Items [0, n) in fixed chunks of 256: partial[c] = scan(begin, end) for chunk c, on the
+// threads when n > threshold; returns the number of chunks. A caller that takes partial[0],
+// partial[1], ... in order gets a result with the same bits on any thread count (an OpenMP
+// reduction's does not). `partial` grows once and is reused (no allocation per call). The chunk
+// is small enough that a scene just above the threshold (the 10k REV) gives 16 threads several
+// chunks each.
+template <class T, class Scan>
+long scan_fixed_chunks(long n, long threshold, std::vector<T>& partial, Scan&& scan) {
   constexpr long chunk = 256;
   const long chunks = (n + chunk - 1) / chunk;
   if (static_cast<long>(partial.size()) < chunks) partial.resize(static_cast<std::size_t>(chunks));
-  for_each_index(chunks, n > threshold, [&](long c) {
+  for_each_index(chunks, n > threshold, [&](long c) { partial[static_cast<std::size_t>(c)] = scan(c * chunk, std::min(n, (c + 1) * chunk)); });
+  return chunks;
+}
+
+// sum over i < n of term(i), each term evaluated once (it may update state of item i): the
+// chunks of scan_fixed_chunks summed, then their sums added in order (the half kicks of a damped
+// scene run through here).
+template <class Term>
+double fixed_order_sum(long n, long threshold, std::vector<double>& partial, Term&& term) {
+  const long chunks = scan_fixed_chunks(n, threshold, partial, [&term](long begin, long end) {
     double sum = 0.0;
-    for (long i = c * chunk, end = std::min(n, (c + 1) * chunk); i < end; ++i) sum += term(i);
-    partial[static_cast<std::size_t>(c)] = sum;
+    for (long i = begin; i < end; ++i) sum += term(i);
+    return sum;
   });
   double total = 0.0;
   for (long c = 0; c < chunks; ++c) total += partial[static_cast<std::size_t>(c)];

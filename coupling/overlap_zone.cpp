@@ -135,9 +135,9 @@ OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting
     const Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
     shape.solid.push_back({n, dot(n, base) + c.radius});
   }
-  const Vec3 top = base + length * axis, margin{c.radius, c.radius, c.radius};
+  const Vec3 top = base + length * axis;
   for (int k = 0; k < 3; ++k)
-    shape.bounds.lower[k] = std::min(base[k], top[k]) - margin[k], shape.bounds.upper[k] = std::max(base[k], top[k]) + margin[k];
+    shape.bounds.lower[k] = std::min(base[k], top[k]) - c.radius, shape.bounds.upper[k] = std::max(base[k], top[k]) + c.radius;
   const Region region{c};
   std::ostringstream d;
   d << "cylinder base " << vec(base) << " axis " << vec(axis) << " radius " << c.radius << " length " << length

@@ -558,12 +558,9 @@ void DemModel::check_finite() const {
   // Chunks of DEs on the threads, split as the kicks, each finding its non-finite velocities and,
   // with contact, its fastest and most crowded DE (the first of equals); the chunks are then taken
   // in order with the same strict comparisons, so the DEs named are the serial pass's.
-  constexpr long chunk = 256;
-  const long chunks = (n + chunk - 1) / chunk;
-  if (static_cast<long>(finite_chunks_.size()) < chunks) finite_chunks_.resize(static_cast<std::size_t>(chunks));
-  for_each_index(chunks, n > parallel_threshold, [&](long c) {
+  const long chunks = scan_fixed_chunks(n, parallel_threshold, finite_chunks_, [&](long begin, long end) {
     FiniteScan scan;
-    for (long k = c * chunk, end = std::min(n, (c + 1) * chunk); k < end; ++k) {
+    for (long k = begin; k < end; ++k) {
       const auto i = static_cast<std::size_t>(k);
       if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
         if (scan.bad++ == 0) scan.first = i;
@@ -575,7 +572,7 @@ void DemModel::check_finite() const {
         if (const double row = bond_frequency_bound_[i] + contact_frequency_bound(i, touching_[i]); row > worst.omega2)
           worst.omega2 = row, worst.crowded = i;
     }
-    finite_chunks_[static_cast<std::size_t>(c)] = scan;
+    return scan;
   });
   std::size_t bad = 0, first = 0;
   ContactResolution worst;  // with contact

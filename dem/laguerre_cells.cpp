@@ -28,9 +28,8 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
     for (int k = 0; k < 3; ++k) lo[k] = std::max(lo[k], within->lower[k]), hi[k] = std::min(hi[k], within->upper[k]);
   // Spheres far larger than the median (an impactor among yarn DEs) are a neighbour of every
   // cell rather than binned: binned, they would set the bins' size to theirs.
-  std::vector<double> sorted(r);
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(n / 2), sorted.end());
-  const double large = NeighbourList::large_radius_ratio * sorted[n / 2];
+  std::vector<double> scratch;
+  const double large = NeighbourList::large_radius(r, scratch);
   std::vector<std::size_t> large_ones;
   double r_max = 0.0;  // of the binned spheres
   for (std::size_t i = 0; i < n; ++i) {

@@ -38,10 +38,7 @@ void NeighbourList::build(const ParticleSet& p) {
   // A DE far larger than the median (an impactor among yarn DEs) would make every cell its
   // size and each cell hold hundreds of DEs: such DEs stay out of the cells and are tested
   // against every DE instead, O(n) each.
-  std::vector<double>& radii = scratch_radius_;
-  radii.assign(p.radius.begin(), p.radius.end());
-  std::nth_element(radii.begin(), radii.begin() + n / 2, radii.end());
-  const double large = large_radius_ratio * radii[n / 2];
+  const double large = large_radius(p.radius, scratch_radius_);
   double r_max = 0.0;
   large_.clear();
   for (std::size_t i = 0; i < n; ++i)
@@ -114,6 +111,13 @@ void NeighbourList::build(const ParticleSet& p) {
   });
   for (const auto& list : found_) pairs_.insert(pairs_.end(), list.begin(), list.end());
   std::sort(pairs_.begin(), pairs_.end());
+}
+
+double NeighbourList::large_radius(std::span<const double> radii, std::vector<double>& scratch) {
+  scratch.assign(radii.begin(), radii.end());
+  const auto middle = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() / 2);
+  std::nth_element(scratch.begin(), middle, scratch.end());
+  return large_radius_ratio * *middle;
 }
 
 bool NeighbourList::needs_rebuild(const ParticleSet& p) const {

@@ -38,6 +38,9 @@ class NeighbourList {
   // A DE of a radius above this ratio to the median is tested against every DE rather than
   // binned: the cells stay the size of the many small DEs.
   static constexpr double large_radius_ratio = 4.0;
+  // The radius above which a DE is large: large_radius_ratio x the median of `radii` (not
+  // empty); `scratch` takes a copy of them (the Laguerre cells bin their spheres the same way).
+  static double large_radius(std::span<const double> radii, std::vector<double>& scratch);
 
  private:
   double skin_;
