@@ -93,7 +93,7 @@ constexpr KeyDoc dem_bond_keys[] = {
 constexpr KeyDoc material_bond_keys[] = {bond_law_key};
 constexpr KeyDoc contact_keys[] = {
     {"law", KeyType::choice, "", {}, "", "the contact law (arlequin laws); its own keys follow in 'contact (law: ...)'", "penalty"},
-    {"skin", KeyType::number, "m", Range::positive(), "(0.2 x the mean radius)", "neighbour list margin: rebuilt when a DE has moved half of it"},
+    {"skin", KeyType::number, "m", Range::positive(), "(0.2 x the mean radius)", "neighbour list margin: rebuilt once the two largest displacements since the last build add up to it"},
 };
 constexpr KeyDoc materials_keys[] = {
     {"<name>", KeyType::section, "", {}, "", "one material, under a name of the user's"},

@@ -219,8 +219,8 @@ void DemModel::advance_to_forces(double dt) {
   }
   time_ += dt;
   {
-    const PhaseTimer timer(profile_, phase_.neighbours, false);
-    update_neighbours();              // only with contact, only when a DE moved > skin/2
+    const PhaseTimer timer(profile_, phase_.neighbours, particles_threaded);
+    update_neighbours();              // only with contact, once two DEs may have closed the skin
   }
   // Bonds, contacts -> f(n+1); breakable: also each bond's failure measure or virial; before
   // an output row: also each bond's energy.

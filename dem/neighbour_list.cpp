@@ -21,6 +21,7 @@ void NeighbourList::set_exclusions(std::vector<std::pair<std::uint32_t, std::uin
   excluded_.clear();
   for (auto [i, j] : excluded) excluded_.push_back(key_of(std::min(i, j), std::max(i, j)));
   std::sort(excluded_.begin(), excluded_.end());
+  excluded_start_.clear();  // set again by the next build, which knows the DE count
 }
 
 void NeighbourList::build(const ParticleSet& p) {
@@ -29,6 +30,14 @@ void NeighbourList::build(const ParticleSet& p) {
   position_at_build_ = p.position;
   ++builds_;
   if (n < 2) return;
+  // Each DE's excluded partners after it: excluded_'s keys i * 2^32 + j from excluded_start_[i]
+  // on (a few per DE, scanned; a search of all the keys took a third of the build).
+  if (excluded_start_.size() != n + 1) {
+    excluded_start_.assign(n + 1, 0);
+    for (const std::uint64_t key : excluded_)
+      if (const std::uint64_t i = key >> 32; i < n) ++excluded_start_[i + 1];
+    for (std::size_t i = 0; i < n; ++i) excluded_start_[i + 1] += excluded_start_[i];
+  }
   Vec3 lo = p.position[0], hi = p.position[0];
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -57,44 +66,50 @@ void NeighbourList::build(const ParticleSet& p) {
   while (cells_along(0) * cells_along(1) * cells_along(2) > cap) h *= 1.25;
   const auto nx = static_cast<std::int64_t>(cells_along(0)), ny = static_cast<std::int64_t>(cells_along(1)),
              nz = static_cast<std::int64_t>(cells_along(2));
-  const auto cell_of = [&](const Vec3& x) {
-    const auto c = [&](int k, std::int64_t count) { return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1); };
-    return (c(0, nx) * ny + c(1, ny)) * nz + c(2, nz);
+  const auto cell_along = [&](const Vec3& x, int k, std::int64_t count) {
+    return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1);
   };
   // The DEs by cell (a counting sort; within a cell, by index).
   cell_start_.assign(static_cast<std::size_t>(nx * ny * nz) + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (p.radius[i] <= large) ++cell_start_[static_cast<std::size_t>(cell_of(p.position[i])) + 1];
+  cell_of_de_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p.radius[i] > large) continue;
+    const Vec3& x = p.position[i];
+    cell_of_de_[i] = static_cast<std::uint32_t>((cell_along(x, 0, nx) * ny + cell_along(x, 1, ny)) * nz + cell_along(x, 2, nz));
+    ++cell_start_[cell_of_de_[i] + 1];
+  }
   for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
   cell_des_.resize(cell_start_.back());
   scratch_next_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
-    if (p.radius[i] <= large) cell_des_[scratch_next_[static_cast<std::size_t>(cell_of(p.position[i]))]++] = static_cast<std::uint32_t>(i);
-  const auto consider = [&](std::uint32_t i, std::uint32_t j, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
-    const double reach = p.radius[i] + p.radius[j] + skin_;
-    if (norm2(p.position[j] - p.position[i]) >= reach * reach) return;
-    const std::uint32_t lo_id = std::min(i, j), hi_id = std::max(i, j);
-    if (std::binary_search(excluded_.begin(), excluded_.end(), key_of(lo_id, hi_id))) return;
-    out.emplace_back(lo_id, hi_id);
+    if (p.radius[i] <= large) cell_des_[scratch_next_[cell_of_de_[i]]++] = static_cast<std::uint32_t>(i);
+  // The pair (i, j), i < j, if within reach and not excluded.
+  const auto consider = [&](std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
+    const double reach = p.radius[a] + p.radius[b] + skin_;
+    if (norm2(p.position[b] - p.position[a]) >= reach * reach) return;
+    const std::uint32_t i = std::min(a, b), j = std::max(a, b);
+    for (std::uint32_t k = excluded_start_[i]; k < excluded_start_[i + 1]; ++k)
+      if (static_cast<std::uint32_t>(excluded_[k]) == j) return;
+    out.emplace_back(i, j);
   };
-  for (std::size_t a = 0; a < large_.size(); ++a)
-    for (std::uint32_t j = 0; j < n; ++j)
-      if (p.radius[j] <= large || j > large_[a]) consider(large_[a], j, pairs_);
   // Each cell against itself and the neighbours after it in cell order: every pair of cells
-  // once. On threads each collects its own pairs; the sort below makes the list the same
-  // whatever thread found a pair.
+  // once. On threads each collects its own pairs, in an order that depends on the threads.
   const std::int64_t cells = nx * ny * nz;
   const bool threaded = static_cast<long>(n) > parallel_threshold;
-  found_.resize(std::max<std::size_t>(found_.size(), static_cast<std::size_t>(runs_threaded(threaded) ? max_threads() : 1)));
+  const auto teams = static_cast<std::size_t>(runs_threaded(threaded) ? max_threads() : 1);
+  if (found_.size() < teams) found_.resize(teams);
   for (auto& list : found_) list.clear();
+  for (const std::uint32_t i : large_)
+    for (std::uint32_t j = 0; j < n; ++j)
+      if (p.radius[j] <= large || j > i) consider(i, j, found_[0]);
   run_threaded_if(threaded, [&] {
     std::vector<std::pair<std::uint32_t, std::uint32_t>>& out = found_[static_cast<std::size_t>(thread_index())];
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t c = 0; c < cells; ++c) {
-      const std::int64_t cx = c / (ny * nz), cy = c / nz % ny, cz = c % nz;
       const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
       const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
       if (begin == end) continue;  // most cells of a sparse scene
+      const std::int64_t cx = c / (ny * nz), cy = c / nz % ny, cz = c % nz;
       for (const std::uint32_t* a = begin; a != end; ++a)
         for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b, out);
       for (std::int64_t dx = -1; dx <= 1; ++dx)
@@ -109,8 +124,19 @@ void NeighbourList::build(const ParticleSet& p) {
           }
     }
   });
-  for (const auto& list : found_) pairs_.insert(pairs_.end(), list.begin(), list.end());
-  std::sort(pairs_.begin(), pairs_.end());
+  // The list sorted by (i, j), so the same whatever thread found a pair: a counting sort by i,
+  // then each DE's few partners in order (a comparison sort of the whole list took as long as
+  // the search).
+  first_start_.assign(n + 1, 0);
+  for (std::size_t t = 0; t < teams; ++t)
+    for (const auto& [i, j] : found_[t]) ++first_start_[i + 1];
+  for (std::size_t i = 0; i < n; ++i) first_start_[i + 1] += first_start_[i];
+  pairs_.resize(first_start_[n]);
+  scratch_next_.assign(first_start_.begin(), first_start_.end() - 1);
+  for (std::size_t t = 0; t < teams; ++t)
+    for (const auto& pair : found_[t]) pairs_[scratch_next_[pair.first]++] = pair;
+  for (std::size_t i = 0; i < n; ++i)
+    if (first_start_[i + 1] - first_start_[i] > 1) std::sort(pairs_.begin() + first_start_[i], pairs_.begin() + first_start_[i + 1]);
 }
 
 double NeighbourList::large_radius(std::span<const double> radii, std::vector<double>& scratch) {
@@ -123,18 +149,28 @@ double NeighbourList::large_radius(std::span<const double> radii, std::vector<do
 bool NeighbourList::needs_rebuild(const ParticleSet& p) const {
   if (position_at_build_.size() != p.size()) return true;
   // A pair left out had a gap of at least the skin at the build; since then it closed by at most
-  // the sum of the two DEs' displacements, so at most the sum of the two largest.
-  double first = 0.0, second = 0.0;  // the two largest squared displacements
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double d2 = norm2(p.position[i] - position_at_build_[i]);
-    if (d2 > first) {
-      second = first;
-      first = d2;
-    } else if (d2 > second) {
-      second = d2;
+  // the sum of the two DEs' displacements, so at most the sum of the two largest. Chunk by chunk
+  // on the threads; the two largest of all do not depend on the order they are met in.
+  using Largest = std::pair<double, double>;  // the two largest squared displacements
+  const auto add = [](Largest& top, double d2) {
+    if (d2 > top.first) {
+      top.second = top.first;
+      top.first = d2;
+    } else if (d2 > top.second) {
+      top.second = d2;
     }
+  };
+  const long chunks = scan_fixed_chunks(static_cast<long>(p.size()), parallel_threshold, largest_moves_, [&](long begin, long end) {
+    Largest top{0.0, 0.0};
+    for (long i = begin; i < end; ++i) add(top, norm2(p.position[static_cast<std::size_t>(i)] - position_at_build_[static_cast<std::size_t>(i)]));
+    return top;
+  });
+  Largest top{0.0, 0.0};
+  for (long c = 0; c < chunks; ++c) {
+    add(top, largest_moves_[static_cast<std::size_t>(c)].first);
+    add(top, largest_moves_[static_cast<std::size_t>(c)].second);
   }
-  return std::sqrt(first) + std::sqrt(second) > skin_;
+  return std::sqrt(top.first) + std::sqrt(top.second) > skin_;
 }
 
 void NeighbourList::save_state(StateArchive& archive, const std::string& prefix) const {

@@ -45,12 +45,16 @@ class NeighbourList {
  private:
   double skin_;
   std::vector<std::uint64_t> excluded_;  // sorted keys i * 2^32 + j
+  std::vector<std::uint32_t> excluded_start_;  // per DE, where its keys begin in excluded_ (build's)
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs_;
   std::vector<Vec3> position_at_build_;
   std::vector<std::uint32_t> cell_start_;  // build's grid: per cell, where its DEs begin in cell_des_
   std::vector<std::uint32_t> cell_des_;    // the binned DEs, by cell, then index
   std::vector<std::uint32_t> scratch_next_;
+  std::vector<std::uint32_t> cell_of_de_;  // build's: each binned DE's cell
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // build's pairs, per thread
+  std::vector<std::uint32_t> first_start_;  // build's: per DE, where its pairs (as the first) begin
+  mutable std::vector<std::pair<double, double>> largest_moves_;  // needs_rebuild's, per chunk
   std::vector<std::uint32_t> large_;   // DEs kept out of the cells (build's scratch)
   std::vector<double> scratch_radius_;  // build's scratch, for the median radius
   std::size_t builds_ = 0;

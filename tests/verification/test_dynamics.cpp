@@ -280,9 +280,9 @@ TEST(PenaltyContact, FrictionOpposesSlidingWithTheCoulombForce) {
 
 // The neighbour list keeps a DE far larger than the median (an impactor) out of its cells and
 // tests it against every DE: the pairs are those of a brute-force search over all pairs
-// (within R_i + R_j + skin, excluded pairs left out), with the impactor among small DEs, a
-// second impactor near it, and small DEs at a distance from both; built on one and on two
-// threads (above the threshold, each thread collecting the pairs of its cells).
+// (within R_i + R_j + skin, excluded pairs left out), in (i, j) order, with the impactor among
+// small DEs, a second impactor near it, and small DEs at a distance from both; built on one and
+// on two threads (above the threshold, each thread collecting the pairs of its cells).
 TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
   ParticleSet p;
   std::mt19937_64 rng(7);
@@ -293,19 +293,25 @@ TEST(NeighbourList, LargeDesAmongSmallOnesFindTheSamePairsAsBruteForce) {
   p.add({4e-3, 4e-3, 2.5e-3}, 2e-3, 7530.0);   // the impactor, touching the bed
   p.add({4e-3, 7e-3, 3.3e-3}, 1.5e-3, 7530.0);  // another, touching the first and the bed
   const std::uint32_t n = static_cast<std::uint32_t>(p.size());
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> expected;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> within;
   for (std::uint32_t i = 0; i < n; ++i)
     for (std::uint32_t j = i + 1; j < n; ++j) {
-      if ((i == 3 && j == 4) || (i == 17 && j == n - 2)) continue;
       const double reach = p.radius[i] + p.radius[j] + skin;
-      if (norm2(p.position[j] - p.position[i]) < reach * reach) expected.emplace_back(i, j);
+      if (norm2(p.position[j] - p.position[i]) < reach * reach) within.emplace_back(i, j);
     }
+  // Every fifth pair within reach but the two impactors' excluded (as a bond would), given
+  // either way round, and two pairs out of reach; the list is the rest.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> excluded{{3, 4}, {n - 1, 17}}, expected;
+  for (std::size_t k = 0; k < within.size(); ++k)
+    if (k % 5 == 2 && within[k] != std::pair{n - 2, n - 1}) excluded.push_back(k % 2 ? within[k] : std::pair{within[k].second, within[k].first});
+    else expected.push_back(within[k]);
+  ASSERT_GT(std::count_if(excluded.begin(), excluded.end(), [&](auto q) { return q.first >= n - 2 || q.second >= n - 2; }), 5);
   for (const int threads : {1, 2}) {
 #ifdef _OPENMP
     const test::OmpThreads scope(threads);
 #endif
     NeighbourList list(skin);
-    list.set_exclusions({{3, 4}, {n - 2, 17}});
+    list.set_exclusions(excluded);
     list.build(p);
     const auto pairs = list.pairs();
     EXPECT_EQ(std::vector(pairs.begin(), pairs.end()), expected) << threads << " thread(s)";
