@@ -81,6 +81,8 @@ constexpr KeyDoc coupling_keys[] = {
      "plain | consistent"},
     {"solver", KeyType::choice, "", {}, "petsc", "the multiplier solve: PETSc (options below) or our sparse LDL^T", "petsc | direct"},
     {"petsc_options", KeyType::string, "", {}, "", "solver: petsc: PETSc options of the multiplier system (prefix coupling_)"},
+    {"continuum_substeps", KeyType::integer, "", Range::at_least(1), "1",
+     "the continuum's internal force once every this many steps, as two impulses (multiple time stepping)"},
     {"on_damage_in_overlap", KeyType::choice, "", {}, "stop",
      "a bond the coupling weights (weight < 1) breaks: stop the run, say so once and go on, or hold such bonds intact "
      "(say so once)", "stop | warn | hold"},
@@ -327,6 +329,7 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   const std::string on_damage_in_overlap = section.choice_or("on_damage_in_overlap", "stop", on_damage);
   out.stop_on_damage_in_overlap = on_damage_in_overlap == "stop";
   out.options.hold_overlap_failures = on_damage_in_overlap == "hold";
+  out.options.continuum_substeps = int(section.integer_or("continuum_substeps", 1, Range::at_least(1)));
   static constexpr std::string_view quadratures[] = {"plain", "consistent"};
   out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
   static constexpr std::string_view solvers[] = {"petsc", "direct"};
@@ -363,7 +366,7 @@ class Coupled final : public SceneModel {
   }
   double critical_time_step() const override { return model_->critical_time_step(); }
   SceneEnergies energies() const override {
-    return {dem_.energies(), continuum_.kinetic_energy(), continuum_.strain_energy(), model_->coupling_work(),
+    return {dem_.energies(), model_->continuum_kinetic_energy(), continuum_.strain_energy(), model_->coupling_work(),
             continuum_.dissipated()};
   }
   std::optional<CouplingMonitorValues> monitor() const override {

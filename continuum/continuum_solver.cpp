@@ -667,9 +667,12 @@ double ContinuumSolver::strain_energy() const {
   return 0.5 * e;
 }
 
-double ContinuumSolver::kinetic_energy() const {
+double ContinuumSolver::kinetic_energy(double kick) const {
   double e = 0;
-  for (size_t d = 0; d < v_.size(); ++d) e += 0.5 * mass_[d / 3] * v_[d] * v_[d];
+  for (size_t d = 0; d < v_.size(); ++d) {
+    const double v = is_fixed_[d] ? v_[d] : v_[d] + kick * f_[d] / mass_[d / 3];
+    e += 0.5 * mass_[d / 3] * v * v;
+  }
   return e;
 }
 

@@ -169,7 +169,9 @@ class ContinuumSolver {
   // cases, but a state with a rigid motion 1e6 times its strains would see it. Finite: the
   // point sum of the contract.
   double strain_energy() const;
-  double kinetic_energy() const;
+  // 1/2 v.M v; with `kick` (s): that of the velocities a kick by it with the present forces
+  // would give, the state unchanged (a multiple-time-step caller's synchronised velocities).
+  double kinetic_energy(double kick = 0.0) const;
 
   // Integration points, for output and checks: positions and strain / stress (Voigt): small
   // strain and Cauchy stress, or (finite) Green-Lagrange strain and second Piola-Kirchhoff stress.

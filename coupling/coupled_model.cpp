@@ -103,7 +103,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
 
   time_steps_.dem = dem_.critical_time_step();
   time_steps_.continuum = continuum_.critical_time_step();
-  time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum);
+  time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum / options_.continuum_substeps);
 }
 
 // The targets of the contract's consistent quadrature: g_a = sum_p N(p, a) h_p, h_p = sum over
@@ -148,8 +148,11 @@ std::string CoupledModel::summary() const {
   s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
     << "coupling matrix A: " << solver_->backend() << ", " << solver_->nonzeros() << " non-zeros stored, "
     << solver_->systems() << " system(s) set up once\n"
-    << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum
-    << " s, coupled " << time_steps_.coupled << " s\n";
+    << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum << " s";
+  if (options_.continuum_substeps > 1)
+    s << " (its internal force once every " << options_.continuum_substeps << " steps: "
+      << time_steps_.continuum / options_.continuum_substeps << " s a step)";
+  s << ", coupled " << time_steps_.coupled << " s\n";
   return s.str();
 }
 
@@ -177,6 +180,7 @@ void CoupledModel::step(double dt) {
   solve_and_correct(dt);
   continuum_.end_step_work();
   time_ += dt;
+  last_dt_ = dt;
   ++steps_;
 }
 
@@ -189,16 +193,20 @@ void CoupledModel::constraint_half_kick(double dt) {
 
 void CoupledModel::advance_models(double dt) {
   dem_.advance_to_forces(dt);
-  continuum_.kick(0.5 * dt);
+  // The continuum's forces as two impulses a macro step of m steps apart (theory.md#continuum-substeps):
+  // the first half kick opens the macro step, the forces and the second close it.
+  const int m = options_.continuum_substeps;
+  if (steps_ % m == 0) continuum_.kick(0.5 * m * dt);
   continuum_.drift(dt);
-  continuum_.compute_forces();
+  if ((steps_ + 1) % m == 0) continuum_.compute_forces();
   gather_dem_velocity(vd_);
   solver_->residual(vd_, continuum_velocity(), drift_residual_);
 }
 
 void CoupledModel::kick_to_trial(double dt) {
   dem_.finish_step(dt);
-  continuum_.kick(0.5 * dt);
+  const int m = options_.continuum_substeps;
+  if ((steps_ + 1) % m == 0) continuum_.kick(0.5 * m * dt);
 }
 
 std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
@@ -255,6 +263,14 @@ std::array<double, 2> CoupledModel::acceleration_norm() const {
   return {sum, sum_c};
 }
 
+double CoupledModel::continuum_kinetic_energy() const {
+  // Inside a macro step of the continuum's substeps (theory.md#continuum-substeps) its velocities
+  // carry the opening impulse m dt/2 M^-1 f whole; j steps in, the force's share so far is j dt,
+  // so the energy is taken at v - (m/2 - j) dt M^-1 f, as if the force acted evenly.
+  const int m = options_.continuum_substeps, j = static_cast<int>(steps_ % m);
+  return continuum_.kinetic_energy(j == 0 ? 0.0 : -(0.5 * m - j) * last_dt_);
+}
+
 CouplingMonitor CoupledModel::monitor() const {
   Matrix3 vd, residual;
   gather_dem_velocity(vd);
@@ -281,7 +297,7 @@ CouplingMonitor CoupledModel::monitor() const {
 CoupledEnergies CoupledModel::energies() const {
   CoupledEnergies e;
   e.dem = dem_.energies();
-  e.continuum_kinetic = continuum_.kinetic_energy();
+  e.continuum_kinetic = continuum_kinetic_energy();
   e.continuum_strain = continuum_.strain_energy();
   e.coupling_work = coupling_work_;
   const auto [dem_norm, continuum_norm] = acceleration_norm();

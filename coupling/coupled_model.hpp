@@ -53,8 +53,15 @@
 //         of step 2)
 //    Steps 3-5 are the constrained velocity-Verlet correction; step 1 is the same constraint force applied
 //    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
-//  - critical_time_step() = min(DEM, continuum): the constrained system's highest frequency
-//    is at most the larger of the two (Rayleigh quotient over a subspace).
+//  - options.continuum_substeps = m > 1 (multiple time stepping; "coupling.continuum_substeps"):
+//    the continuum's internal force is computed once every m steps and applied as two impulses,
+//    m dt/2 M^-1 f at the first step of each macro step of m steps and at its last (r-RESPA's
+//    impulse form: Tuckerman, Berne & Martyna, J. Chem. Phys. 97 (1992); still time-reversible
+//    and symplectic); the continuum drifts and the constraint is solved every step. m = 1 is
+//    step 2 and 3 above.
+//  - critical_time_step() = min(DEM, continuum / m): the constrained system's highest frequency
+//    is at most the larger of the two (Rayleigh quotient over a subspace), and the continuum's
+//    macro step m dt must stay below its own.
 //  - energies(): DEM kinetic + bond + contact and continuum kinetic + strain (both weighted),
 //    DEM external work and dissipation, the work of the multiplier forces, and the O(dt^2)
 //    difference to velocity Verlet's invariant (shadow_total(), conserved to round-off for linear
@@ -91,6 +98,8 @@ struct CoupledOptions {
   // Bonds of the overlap (alpha_d < 1 at their midpoint) do not break when their criterion is
   // met: the continuum they share the load with cannot (coupling.on_damage_in_overlap: hold).
   bool hold_overlap_failures = false;
+  // The continuum's internal force evaluated every this many steps (coupling.continuum_substeps).
+  int continuum_substeps = 1;
 };
 
 // The dofs of a continuum physical group (for held_continuum_dofs).
@@ -155,6 +164,9 @@ class CoupledModel {
   long steps_done() const { return steps_; }
 
   CoupledEnergies energies() const;
+  // The continuum's kinetic energy, J: at velocities in step with its forces when they act every
+  // few steps (options.continuum_substeps), else 1/2 v.M v.
+  double continuum_kinetic_energy() const;
   double coupling_work() const { return coupling_work_; }  // J, as in energies(), without the sums
   // From the state after the last step, on demand: a step computes neither this nor the
   // acceleration norms of energies(), which only output rows and tests read.
@@ -218,6 +230,7 @@ class CoupledModel {
   double coupling_work_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
+  double last_dt_ = 0.0;  // s, the last step's
 };
 
 }  // namespace arlequin::coupling

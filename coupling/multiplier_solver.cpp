@@ -12,15 +12,35 @@ namespace arlequin::coupling {
 
 namespace {
 
-// x = A^-1 x for a factor of A = P^T L D L^T P, spelled out (Eigen's own solve applies the
-// inverse permutation in place, which allocates a mask each call); scratch of x's size.
-void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D,
-                       Eigen::VectorXd& x, Eigen::VectorXd& scratch) {
-  scratch = f.permutationP() * x;
-  f.matrixL().solveInPlace(scratch);
-  scratch.array() /= D.array();
-  f.matrixU().solveInPlace(scratch);
-  x = f.permutationPinv() * scratch;
+// X = A^-1 X for a factor of A = P^T L D L^T P and X of `width` columns, row-major (the
+// components that share A solved together: L is read once for all of them); scratch of X's
+// size. The triangular solves spelled out over L's columns (Eigen's solve takes one column at a
+// time, and applies the inverse permutation in place, which allocates a mask each call).
+template <int width>
+void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, double* x,
+                       std::vector<double>& scratch) {
+  const auto& L = f.matrixL().nestedExpression();  // strictly lower part used: L's diagonal is 1
+  const Eigen::Index n = L.cols();
+  const int* perm = f.permutationP().indices().data();
+  const int* outer = L.outerIndexPtr();
+  const int* inner = L.innerIndexPtr();
+  const double* value = L.valuePtr();
+  scratch.resize(static_cast<std::size_t>(n * width));
+  double* y = scratch.data();
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < width; ++c) y[perm[i] * width + c] = x[i * width + c];
+  for (Eigen::Index j = 0; j < n; ++j)  // L y' = y
+    for (int p = outer[j]; p < outer[j + 1]; ++p)
+      if (inner[p] > j)
+        for (int c = 0; c < width; ++c) y[inner[p] * width + c] -= value[p] * y[j * width + c];
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (int c = 0; c < width; ++c) y[j * width + c] /= D[j];
+  for (Eigen::Index j = n - 1; j >= 0; --j)  // L^T y'' = y'
+    for (int p = outer[j]; p < outer[j + 1]; ++p)
+      if (inner[p] > j)
+        for (int c = 0; c < width; ++c) y[j * width + c] -= value[p] * y[inner[p] * width + c];
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i] * width + c];
 }
 
 // out = A x for a row-major A and x of `width` columns whose rows lie `stride` apart (a Matrix3,
@@ -89,7 +109,7 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
   Eigen::VectorXd r(rows), y(rows);
   for (int i = 0; i < rows; ++i) r[i] = 1.0 + 0.5 * std::sin(1.0 + i);
   y = r;
-  solve_low_rank(*a, y);
+  solve_low_rank<1>(*a, y.data());
   Eigen::VectorXd Ay = y.cwiseQuotient(a->inv_D);
   const Eigen::VectorXd Uty = a->Ut * y;
   Eigen::VectorXd CUty(k);
@@ -99,14 +119,18 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
   return a;
 }
 
-void MultiplierSolver::solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const {
-  column.array() *= a.inv_D.array();  // y = D^-1 r
-  reduced_.resize(a.U.cols());
-  multiply<1>(a.Ut, column.data(), 1, reduced_.data());  // U^T y
-  solve_with_factor(*a.K, a.K_diagonal, reduced_, reduced_scratch_);
-  solution_.resize(a.U.rows());
-  multiply<1>(a.U, reduced_.data(), 1, solution_.data());  // U K^-1 U^T y
-  column.array() -= a.inv_D.array() * solution_.array();
+template <int width>
+void MultiplierSolver::solve_low_rank(const LowRank& a, double* x) const {
+  const Eigen::Index rows = a.U.rows();
+  for (Eigen::Index r = 0; r < rows; ++r)  // y = D^-1 r
+    for (int c = 0; c < width; ++c) x[r * width + c] *= a.inv_D[r];
+  reduced_.resize(static_cast<std::size_t>(a.U.cols() * width));
+  multiply<width>(a.Ut, x, width, reduced_.data());  // U^T y
+  solve_with_factor<width>(*a.K, a.K_diagonal, reduced_.data(), reduced_scratch_);
+  solution_.resize(static_cast<std::size_t>(rows * width));
+  multiply<width>(a.U, reduced_.data(), width, solution_.data());  // U K^-1 U^T y
+  for (Eigen::Index r = 0; r < rows; ++r)
+    for (int c = 0; c < width; ++c) x[r * width + c] -= a.inv_D[r] * solution_[static_cast<std::size_t>(r * width + c)];
 }
 
 int MultiplierSolver::system_of_earlier_component(int c) const {
@@ -193,35 +217,52 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
   }
 }
 
-// The factor's solve spelled out, S P^T L D L^T P S lambda = rhs with the Jacobi scaling S:
-// Eigen's own applies the inverse permutation in place, which allocates a mask each call.
+// Per system, the components it serves solved together (columns of one row-major block): the
+// low-rank form, PETSc's KSP (a column at a time), or our factor of the Jacobi-scaled A,
+// S P^T L D L^T P S lambda = rhs.
 void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
   lambda.resize(rhs.rows(), 3);
-  for (int c = 0; c < 3; ++c) {
-    const int k = factor_of_[c];
-    if (!low_rank_.empty()) {
-      column_ = rhs.col(c);
-      solve_low_rank(*low_rank_[k], column_);
-      lambda.col(c) = column_;
-      continue;
-    }
-    column_ = rhs.col(c).cwiseProduct(scales_[k]);
+  const Eigen::Index rows = rhs.rows();
+  for (int k = 0; k < systems(); ++k) {
+    std::array<int, 3> served{};
+    int width = 0;
+    for (int c = 0; c < 3; ++c)
+      if (factor_of_[c] == k) served[static_cast<std::size_t>(width++)] = c;
     if (!petsc_.empty()) {
       // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
       // from another component or step would make the multipliers depend on the run's history,
       // which a restart (docs/restart.md) could not reproduce.
-      solution_.setZero(column_.size());
-      petsc_[k]->solve(column_.data(), solution_.data());
-      lambda.col(c) = solution_.cwiseProduct(scales_[k]);
+      for (int s = 0; s < width; ++s) {
+        const int c = served[static_cast<std::size_t>(s)];
+        column_ = rhs.col(c).cwiseProduct(scales_[k]);
+        solution_.assign(static_cast<std::size_t>(rows), 0.0);
+        petsc_[k]->solve(column_.data(), solution_.data());
+        lambda.col(c) = Eigen::Map<const Eigen::VectorXd>(solution_.data(), rows).cwiseProduct(scales_[k]);
+      }
       continue;
     }
-    solve_with_factor(*factors_[k], diagonals_[k], column_, solution_);
-    lambda.col(c) = column_.cwiseProduct(scales_[k]);
+    block_.resize(static_cast<std::size_t>(rows * width));
+    const double* scale = low_rank_.empty() ? scales_[k].data() : nullptr;
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (int s = 0; s < width; ++s)
+        block_[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * (scale ? scale[r] : 1.0);
+    const auto solve_block = [&]<int w>() {
+      if (low_rank_.empty()) solve_with_factor<w>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
+      else solve_low_rank<w>(*low_rank_[k], block_.data());
+    };
+    if (width == 3) solve_block.template operator()<3>();
+    else if (width == 2) solve_block.template operator()<2>();
+    else solve_block.template operator()<1>();
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (int s = 0; s < width; ++s)
+        lambda(r, served[static_cast<std::size_t>(s)]) = block_[static_cast<std::size_t>(r * width + s)] * (scale ? scale[r] : 1.0);
   }
 }
 
 std::string MultiplierSolver::backend() const {
-  if (!low_rank_.empty()) return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_.front()->U.cols()) + " continuum dofs";
+  if (!low_rank_.empty())
+    return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_.front()->U.cols()) + " continuum dofs (" +
+           std::to_string(low_rank_.front()->K->matrixL().nestedExpression().nonZeros()) + " non-zeros in its factor)";
   return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description();
 }
 

@@ -90,7 +90,9 @@ class MultiplierSolver {
   // The low-rank form of A for inverse masses (md, mc), or nullptr when it does not apply or its
   // set-up residual check fails.
   std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc) const;
-  void solve_low_rank(const LowRank& a, Eigen::VectorXd& column) const;
+  // x = A^-1 x for `width` components (rows x width, row-major).
+  template <int width>
+  void solve_low_rank(const LowRank& a, double* x) const;
   // The system of an earlier component with the same continuum inverse masses (the DEs' are the
   // same for all three components), or -1.
   int system_of_earlier_component(int c) const;
@@ -106,8 +108,9 @@ class MultiplierSolver {
   std::array<int, 3> factor_of_{0, 0, 0};      // component -> factor
   long nonzeros_ = 0;
   mutable Matrix3 rhs_;                        // scratch: the residual to project
-  mutable Eigen::VectorXd column_, solution_;  // scratch: one component
-  mutable Eigen::VectorXd reduced_, reduced_scratch_;  // scratch: the low-rank form's K solve
+  mutable Eigen::VectorXd column_;              // scratch: one component (PETSc)
+  mutable std::vector<double> block_, block_scratch_, solution_;  // scratch: a system's components
+  mutable std::vector<double> reduced_, reduced_scratch_;  // scratch: the low-rank form's K solve
 };
 
 }  // namespace arlequin::coupling

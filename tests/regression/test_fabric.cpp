@@ -157,9 +157,11 @@ std::vector<std::map<std::string, std::string>> run_coupled(const std::string& n
   return r.exit_code == 0 ? test::read_csv(out / "series.csv") : std::vector<std::map<std::string, std::string>>{};
 }
 
-// Without breakage: the balance (both models and the multipliers' work) stays within 2e-4 of the
-// impact energy (measured 6.2e-5), the multipliers do no work (1e-12 of it; measured 1.6e-17),
-// and the plate takes its share (measured 0.45 J at 40 us; bound 0.1 J).
+// Without breakage: the balance (both models and the multipliers' work) stays within 6e-4 of the
+// impact energy (measured 4.1e-4 with the case's plate force once every 6 steps: velocity Verlet's
+// error of the plate at its macro step, theory.md#continuum-substeps; 8.2e-5 every step), the
+// multipliers do no work (1e-12 of it; measured 1.6e-17), and the plate takes its share
+// (measured 0.45 J at 40 us; bound 0.1 J).
 TEST(FabricCoupled, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -169,11 +171,37 @@ TEST(FabricCoupled, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
   ASSERT_FALSE(rows.empty());
   const double E0 = impact_energy();
   EXPECT_NEAR(at(rows.front(), "E_total") / E0, 1.0, 1e-5);
-  EXPECT_LT(worst_balance(rows), 2e-4 * E0);
+  EXPECT_LT(worst_balance(rows), 6e-4 * E0);
   double coupling_work = 0.0;
   for (const auto& row : rows) coupling_work = std::max(coupling_work, std::abs(at(row, "W_coupling")));
   EXPECT_LT(coupling_work, 1e-12 * E0);
   EXPECT_GT(at(rows.back(), "C_kinetic") + at(rows.back(), "C_strain"), 0.1);
+}
+
+// The plate's internal force once every 6 steps (reduced.yaml's continuum_substeps, r-RESPA's
+// impulses) against every step, without breakage: the sphere's velocity follows the every-step
+// run within 0.5 % of its 90 m/s (measured 0.15 %), the plate's peak strain energy within 1 %
+// (measured -0.27 %), and the every-step run's balance stays within 2e-4 of the impact energy
+// (measured 8.2e-5).
+TEST(FabricCoupled, ThePlateForcedEverySixthStepFollowsTheEveryStepRun) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  std::filesystem::path out;
+  const auto substeps = run_coupled("fabric_coupled_substeps_6", " --set dem.sample.yarn.failure_strain=0", out);
+  const auto every_step = run_coupled("fabric_coupled_substeps_1",
+                                      " --set dem.sample.yarn.failure_strain=0 --set coupling.continuum_substeps=1", out);
+  ASSERT_EQ(substeps.size(), every_step.size());
+  ASSERT_FALSE(substeps.empty());
+  double velocity = 0.0, peak_6 = 0.0, peak_1 = 0.0;
+  for (std::size_t k = 0; k < substeps.size(); ++k) {
+    velocity = std::max(velocity, std::abs(at(substeps[k], "sphere_velocity") - at(every_step[k], "sphere_velocity")));
+    peak_6 = std::max(peak_6, at(substeps[k], "C_strain"));
+    peak_1 = std::max(peak_1, at(every_step[k], "C_strain"));
+  }
+  EXPECT_LT(velocity, 0.005 * 90.0);
+  EXPECT_NEAR(peak_6 / peak_1, 1.0, 0.01);
+  EXPECT_LT(worst_balance(every_step), 2e-4 * impact_energy());
 }
 
 // With breakage and `on_damage_in_overlap: hold`: springs of the overlap that reach the failure
@@ -235,9 +263,11 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
 
 // Validation: the coupled seed target against the pure-DEM run (`arlequin compare`, both with
 // breakage, about 30 s): the bounds, the sphere's velocity history within 5 % (max
-// relative over the 100 us; measured 0.92 % of its largest value, 1.22 % pointwise), the peak
-// impact force within 10 % (measured +2.75 %), the first break within 10 % (measured -0.34 %);
-// and without breakage the coupled balance within 1 % of the impact energy (measured 7.3e-5).
+// relative over the 100 us; measured 4.72 % of its largest value), the peak impact force within
+// 10 % (measured -7.65 %), the first break within 10 % (measured -5.99 %); and without breakage
+// the coupled balance within 1 % of the impact energy (measured 2.8e-4). With breakage the
+// differences move with the last bits of the arithmetic (0.92 %, +2.75 %, -0.34 % on another
+// machine): the case's README says what a breaking weave's comparison can resolve.
 TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
