@@ -180,7 +180,6 @@ void CoupledModel::step(double dt) {
   solve_and_correct(dt);
   continuum_.end_step_work();
   time_ += dt;
-  last_dt_ = dt;
   ++steps_;
 }
 
@@ -195,18 +194,16 @@ void CoupledModel::advance_models(double dt) {
   dem_.advance_to_forces(dt);
   // The continuum's forces as two impulses a macro step of m steps apart (theory.md#continuum-substeps):
   // the first half kick opens the macro step, the forces and the second close it.
-  const int m = options_.continuum_substeps;
-  if (steps_ % m == 0) continuum_.kick(0.5 * m * dt);
+  if (opens_macro_step()) continuum_.kick(0.5 * options_.continuum_substeps * dt);
   continuum_.drift(dt);
-  if ((steps_ + 1) % m == 0) continuum_.compute_forces();
+  if (closes_macro_step()) continuum_.compute_forces();
   gather_dem_velocity(vd_);
   solver_->residual(vd_, continuum_velocity(), drift_residual_);
 }
 
 void CoupledModel::kick_to_trial(double dt) {
   dem_.finish_step(dt);
-  const int m = options_.continuum_substeps;
-  if ((steps_ + 1) % m == 0) continuum_.kick(0.5 * m * dt);
+  if (closes_macro_step()) continuum_.kick(0.5 * options_.continuum_substeps * dt);
 }
 
 std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
@@ -268,7 +265,7 @@ double CoupledModel::continuum_kinetic_energy() const {
   // carry the opening impulse m dt/2 M^-1 f whole; j steps in, the force's share so far is j dt,
   // so the energy is taken at v - (m/2 - j) dt M^-1 f, as if the force acted evenly.
   const int m = options_.continuum_substeps, j = static_cast<int>(steps_ % m);
-  return continuum_.kinetic_energy(j == 0 ? 0.0 : -(0.5 * m - j) * last_dt_);
+  return continuum_.kinetic_energy(j == 0 ? 0.0 : -(0.5 * m - j) * dem_.last_dt());
 }
 
 CouplingMonitor CoupledModel::monitor() const {

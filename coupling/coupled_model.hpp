@@ -201,6 +201,10 @@ class CoupledModel {
   void constraint_half_kick(double dt);
   void advance_models(double dt);
   void kick_to_trial(double dt);
+  // Whether the step in progress is the first, or the last, of a macro step of the continuum's
+  // substeps (both when there is one substep).
+  bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }
+  bool closes_macro_step() const { return (steps_ + 1) % options_.continuum_substeps == 0; }
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
 
   void make_overlap_quadrature_consistent();
@@ -230,7 +234,6 @@ class CoupledModel {
   double coupling_work_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
-  double last_dt_ = 0.0;  // s, the last step's
 };
 
 }  // namespace arlequin::coupling

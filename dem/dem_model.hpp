@@ -100,6 +100,7 @@ class DemModel {
   void set_profile(StepProfile* profile);
   double time() const { return time_; }
   long steps_done() const { return steps_; }
+  double last_dt() const { return last_dt_; }  // s, the last step's size (0 before the first; checkpointed)
 
   // Every break so far, in order; broken bonds' energy is in Energies::fracture.
   const std::vector<BreakEvent>& breaks() const { return breaks_; }

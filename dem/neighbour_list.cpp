@@ -66,16 +66,16 @@ void NeighbourList::build(const ParticleSet& p) {
   while (cells_along(0) * cells_along(1) * cells_along(2) > cap) h *= 1.25;
   const auto nx = static_cast<std::int64_t>(cells_along(0)), ny = static_cast<std::int64_t>(cells_along(1)),
              nz = static_cast<std::int64_t>(cells_along(2));
-  const auto cell_along = [&](const Vec3& x, int k, std::int64_t count) {
-    return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1);
+  const auto cell_of = [&](const Vec3& x) {
+    const auto c = [&](int k, std::int64_t count) { return std::min(static_cast<std::int64_t>((x[k] - lo[k]) / h), count - 1); };
+    return static_cast<std::uint32_t>((c(0, nx) * ny + c(1, ny)) * nz + c(2, nz));
   };
   // The DEs by cell (a counting sort; within a cell, by index).
   cell_start_.assign(static_cast<std::size_t>(nx * ny * nz) + 1, 0);
   cell_of_de_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (p.radius[i] > large) continue;
-    const Vec3& x = p.position[i];
-    cell_of_de_[i] = static_cast<std::uint32_t>((cell_along(x, 0, nx) * ny + cell_along(x, 1, ny)) * nz + cell_along(x, 2, nz));
+    cell_of_de_[i] = cell_of(p.position[i]);
     ++cell_start_[cell_of_de_[i] + 1];
   }
   for (std::size_t c = 1; c < cell_start_.size(); ++c) cell_start_[c] += cell_start_[c - 1];
