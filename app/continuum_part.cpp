@@ -43,6 +43,8 @@ constexpr KeyDoc mesh_keys[] = {
 constexpr KeyDoc material_keys[] = {
     {"model", KeyType::choice, "", {}, "isotropic", "elastic model", "isotropic | transversely_isotropic | orthotropic"},
     {"density", KeyType::number, "kg/m^3", Range::positive(), "", "density"},
+    {"inertia", KeyType::vec3, "1", {0.0, 1.0, true, false}, "[1, 1, 1]",
+     "share of the mass a motion along x, y, z carries, each in (0, 1] (a dry weave: each yarn family's along its axis)"},
     {"E", KeyType::number, "Pa", Range::positive(), "", "isotropic: Young's modulus"},
     {"nu", KeyType::number, "1", Range::open_between(-1, 0.5), "", "isotropic: Poisson's ratio"},
     {"E_L", KeyType::number, "Pa", Range::positive(), "", "transversely isotropic: modulus along the axis"},
@@ -76,6 +78,7 @@ constexpr KeyDoc coupling_keys[] = {
     {"mass_floor", KeyType::number, "1", Range::open_between(0, 1), "0.05", "least weight on a mass (keeps the critical step finite)"},
     {"mediator", KeyType::choice, "", {}, "coarse", "multiplier space: the overlap's nodes, or one per coupled DE", "coarse | fine"},
     {"type", KeyType::choice, "", {}, "l2", "coupling operator: velocities, or velocities and their gradients", "l2 | h1"},
+    {"ties", KeyType::list, "", {}, "(all DEs, x y z)", "DE groups the continuum holds along some components only (fine mediator, l2)"},
     {"length", KeyType::number, "m", Range::positive(), "", "h1: the length weighting the gradient term"},
     {"quadrature", KeyType::choice, "", {}, "plain", "consistent: the continuum's overlap weights corrected against the DE cloud",
      "plain | consistent"},
@@ -98,6 +101,10 @@ constexpr KeyDoc shell_keys[] = {
     {"inner", KeyType::vec3_list, "m", {}, "", "the inner box (pure DEM inside), two corners"},
     {"outer", KeyType::vec3_list, "m", {}, "", "the outer box (pure continuum outside), two corners"},
 };
+constexpr KeyDoc tie_keys[] = {
+    {"group", KeyType::string, "", {}, "", "a DE group (a weave's: weft, stuffer, binder)"},
+    {"components", KeyType::strings, "", {}, "", "the components the continuum holds its overlap DEs along; the others are free"},
+};
 constexpr KeyDoc band_keys[] = {
     {"axis", KeyType::choice, "", {}, "", "the direction across the band", "x | y | z"},
     {"center", KeyType::number, "m", Range::any(), "", "the band's mid-plane, along axis"},
@@ -114,6 +121,7 @@ constexpr SchemaSection continuum_sections[] = {
     {"continuum.boundary[]", "a boundary condition on the continuum", continuum_boundary_keys},
     {"coupling", "Arlequin coupling of the DEM zone and the continuum", coupling_keys},
     {"coupling.overlap", "the overlap (also the keys of region)", overlap_keys},
+    {"coupling.ties[]", "a DE group tied along some components only", tie_keys},
     {"coupling.overlap.shell", "a shell overlap", shell_keys},
     {"coupling.overlap.band", "a band overlap: the shell of a slab, DEM inside, across all of the third direction", band_keys},
 };
@@ -148,6 +156,7 @@ continuum::Material read_material(CaseNode m) {
     if (!(norm(axis) > 0.0)) m.fail("axis", "expected a non-zero direction");
     material = continuum::Material::transversely_isotropic(E_L, E_T, nu_LT, nu_TT, G_LT, normalized(axis), density);
   }
+  material.inertia = m.vec3_or("inertia", {1.0, 1.0, 1.0}, {0.0, 1.0, true, false}, "1");
   m.finish();
   return material;
 }
@@ -175,6 +184,12 @@ struct CouplingCaseSettings {
   coupling::OverlapZone zone;
   coupling::CoupledOptions options{};
   bool stop_on_damage_in_overlap = true;
+  struct Tie {
+    CaseNode node;
+    std::string group;
+    std::array<bool, 3> components;
+  };
+  std::vector<Tie> ties{};  // resolved to DEs when the scene is coupled
 };
 
 // An error of the coupling library at its key in the case's coupling section: a SettingError
@@ -182,6 +197,16 @@ struct CouplingCaseSettings {
 [[noreturn]] void fail_at_coupling_key(const CaseNode& section, const InputError& e) {
   if (const auto* setting = dynamic_cast<const SettingError*>(&e)) section.fail(setting->key(), setting->message());
   section.fail("overlap", e.what());
+}
+
+// `components: [x, z]` of a mapping: which of x, y, z it names.
+std::array<bool, 3> read_components(CaseNode node) {
+  std::array<bool, 3> out{false, false, false};
+  for (const std::string& c : node.strings("components")) {
+    if (c != "x" && c != "y" && c != "z") node.fail("components", "expected a list of x, y, z, got '" + c + "'");
+    out[static_cast<std::size_t>(c[0] - 'x')] = true;
+  }
+  return out;
 }
 
 ContinuumBoundary read_continuum_boundary(CaseNode bc) {
@@ -194,13 +219,7 @@ ContinuumBoundary read_continuum_boundary(CaseNode bc) {
     bc.finish();
     return out;
   }
-  if (bc.has("components")) {
-    out.components = {false, false, false};
-    for (const std::string& c : bc.strings("components")) {
-      if (c != "x" && c != "y" && c != "z") bc.fail("components", "expected a list of x, y, z, got '" + c + "'");
-      out.components[c[0] - 'x'] = true;
-    }
-  }
+  if (bc.has("components")) out.components = read_components(bc);
   if (out.kind == "displacement") {
     out.value = bc.vec3("value", Range::any(), "m");
   } else if (out.kind == "velocity") {
@@ -330,6 +349,12 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   out.stop_on_damage_in_overlap = on_damage_in_overlap == "stop";
   out.options.hold_overlap_failures = on_damage_in_overlap == "hold";
   out.options.continuum_substeps = int(section.integer_or("continuum_substeps", 1, Range::at_least(1)));
+  for (CaseNode tie : section.list_or_empty("ties")) {
+    out.ties.push_back({tie, tie.string("group"), read_components(tie)});
+    tie.finish();
+  }
+  if (!out.ties.empty() && (out.options.coupling.mediator != coupling::Mediator::fine || out.options.coupling.type != coupling::CouplingType::l2))
+    section.fail("ties", "ties of some components need mediator: fine and type: l2 (a multiplier per DE)");
   static constexpr std::string_view quadratures[] = {"plain", "consistent"};
   out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";
   static constexpr std::string_view solvers[] = {"petsc", "direct"};
@@ -428,6 +453,12 @@ class Part final : public ContinuumPart {
     coupling::CoupledOptions options = coupling_->options;
     options.held_continuum_dofs = held_dofs_;
     options.driven_des = dem.driven_particles();
+    if (!coupling_->ties.empty()) options.tied_components.assign(dem.particles.size(), {true, true, true});
+    for (const CouplingCaseSettings::Tie& tie : coupling_->ties) {
+      const int group = dem.group_index(tie.group);
+      if (group < 0) tie.node.fail("group", "no DE group '" + tie.group + "' (a weave has weft, stuffer and binder)");
+      for (std::uint32_t i : dem.members(group)) options.tied_components[i] = tie.components;
+    }
     try {
       return std::make_unique<Coupled>(dem, *this, std::make_unique<coupling::CoupledModel>(dem, *solver_, coupling_->zone, options),
                                        coupling_->stop_on_damage_in_overlap);

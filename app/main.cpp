@@ -245,10 +245,12 @@ void print_scene_facts(const app::Scene& scene) {
                 " DE radius %.4g mm, spring K %.4g N/m\n"
                 "    areal density %.4f kg/m^2, thickness %.4g mm, fibre volume fraction %.3f, yarn mass %.4g g,"
                 " deepest overlap of unjoined DEs %.2g of 2R\n"
-                "    rule of mixtures over that thickness: E_x %.4g GPa (weft), E_y %.4g GPa (stuffers; crimped binders carry nothing)\n",
+                "    rule of mixtures over that thickness: E_x %.4g GPa (weft), E_y %.4g GPa (stuffers; crimped binders carry nothing)\n"
+                "    mass shares: weft %.4f, stuffers %.4f, binders %.4f\n",
                 w.wefts, w.stuffers, w.binders, w.weft_length * 1e3, w.stuffer_length * 1e3, w.binder_length * 1e3, w.amplitude * 1e3,
                 w.crimp, w.radius * 1e3, w.spring_stiffness, w.areal_density, w.thickness * 1e3, w.fibre_volume_fraction, w.mass * 1e3,
-                w.deepest_overlap, w.rule_of_mixtures_x * 1e-9, w.rule_of_mixtures_y * 1e-9);
+                w.deepest_overlap, w.rule_of_mixtures_x * 1e-9, w.rule_of_mixtures_y * 1e-9, w.family_mass[0] / w.mass,
+                w.family_mass[1] / w.mass, w.family_mass[2] / w.mass);
   }
   for (const auto& set : model.bond_sets()) {
     std::printf("  %s (%s): %zu\n", set->name == "bonds" ? "bonds" : (set->name + " bonds").c_str(), std::string(set->law()).c_str(),

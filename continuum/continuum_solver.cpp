@@ -93,6 +93,10 @@ ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings)
   }
   if (std::find(tet_material_.begin(), tet_material_.end(), -1) != tet_material_.end())
     throw InputError("continuum: some tetrahedra lie in no region with a material");
+  // A node on the face between two materials would need a mix of their shares; one share for all.
+  inertia_ = materials_.front().inertia;
+  for (const Material& m : materials_)
+    if (!(m.inertia == inertia_)) throw InputError("continuum: the materials' inertia shares differ (one set for all materials)");
   const size_t ndof = 3 * static_cast<size_t>(mesh_.num_nodes());
   u_.assign(ndof, 0.0);
   v_.assign(ndof, 0.0);
@@ -115,6 +119,8 @@ void ContinuumSolver::set_weight(ScalarFunction alpha) {
   point_weight_.resize(points_.x.size());
   for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
   mass_ = weighted_lumped_mass(alpha_);
+  dof_mass_.resize(3 * mass_.size());
+  for (std::size_t d = 0; d < dof_mass_.size(); ++d) dof_mass_[d] = mass_[d / 3] * inertia_[static_cast<int>(d % 3)];
   stiffness_current_ = false;
 }
 
@@ -381,7 +387,7 @@ void ContinuumSolver::compute_forces() {
   add_external_force(f_);
   if (!(damping_ > 0.0)) return;
   for (size_t d = 0; d < f_.size(); ++d) {
-    damping_force_[d] = is_fixed_[d] ? 0.0 : -damping_ * mass_[d / 3] * v_[d];
+    damping_force_[d] = is_fixed_[d] ? 0.0 : -damping_ * dof_mass_[d] * v_[d];
     f_[d] += damping_force_[d];
   }
 }
@@ -389,7 +395,7 @@ void ContinuumSolver::compute_forces() {
 void ContinuumSolver::kick(double dt) {
   if (!(damping_ > 0.0)) {
     for (size_t d = 0; d < v_.size(); ++d)
-      if (!is_fixed_[d]) v_[d] += dt * f_[d] / mass_[d / 3];
+      if (!is_fixed_[d]) v_[d] += dt * f_[d] / dof_mass_[d];
     return;
   }
   // A kick changes a dof's kinetic energy by dt f (v + v')/2 exactly; the damping force's share
@@ -398,7 +404,7 @@ void ContinuumSolver::kick(double dt) {
   for (size_t d = 0; d < v_.size(); ++d) {
     if (is_fixed_[d]) continue;
     const double v = v_[d];
-    v_[d] += dt * f_[d] / mass_[d / 3];
+    v_[d] += dt * f_[d] / dof_mass_[d];
     work -= dt * damping_force_[d] * 0.5 * (v + v_[d]);
   }
   dissipated_ += work;
@@ -428,7 +434,7 @@ void ContinuumSolver::begin_step_work() {
   step_f_fixed_.resize(fixed_.size());
   for (std::size_t k = 0; k < fixed_.size(); ++k) {
     const int d = fixed_[k].dof;
-    step_work_ -= 0.5 * mass_[d / 3] * v_[d] * v_[d];
+    step_work_ -= 0.5 * dof_mass_[d] * v_[d] * v_[d];
     step_fixed_u_[k] = u_[d];
     step_f_fixed_[k] = f_[d];
   }
@@ -442,7 +448,7 @@ void ContinuumSolver::end_step_work() {
   }
   for (std::size_t k = 0; k < fixed_.size(); ++k) {
     const int d = fixed_[k].dof;
-    step_work_ += 0.5 * mass_[d / 3] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_fixed_u_[k]);
+    step_work_ += 0.5 * dof_mass_[d] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_fixed_u_[k]);
   }
   external_work_ += step_work_;
 }
@@ -460,7 +466,7 @@ void ContinuumSolver::step(double dt) {
 }
 
 void ContinuumSolver::save_state(StateArchive& archive, const std::string& prefix) const {
-  archive.put(prefix + "lumped_mass", mass_);
+  archive.put(prefix + "lumped_mass", dof_mass_);
   archive.put(prefix + "u", u_);
   archive.put(prefix + "v", v_);
   archive.put(prefix + "f", f_);
@@ -471,7 +477,7 @@ void ContinuumSolver::save_state(StateArchive& archive, const std::string& prefi
 }
 
 void ContinuumSolver::load_state(const StateArchive& archive, const std::string& prefix) {
-  if (archive.get<double>(prefix + "lumped_mass") != mass_)
+  if (archive.get<double>(prefix + "lumped_mass") != dof_mass_)
     throw StateMismatch("its continuum's lumped mass differs from this scene's (another mesh, material or weight)");
   archive.get_into(prefix + "u", u_);
   archive.get_into(prefix + "v", v_);
@@ -488,7 +494,7 @@ void ContinuumSolver::load_state(const StateArchive& archive, const std::string&
 double ContinuumSolver::verlet_correction(double dt) const {
   double sum = 0.0;
   for (std::size_t d = 0; d < f_.size(); ++d)
-    if (!is_fixed_[d]) sum += f_[d] * f_[d] / mass_[d / 3];
+    if (!is_fixed_[d]) sum += f_[d] * f_[d] / dof_mass_[d];
   return dt * dt / 8.0 * sum;
 }
 
@@ -497,7 +503,7 @@ double ContinuumSolver::verlet_correction(double dt) const {
 // component along the top modes. dt_c = 2 / omega_max (central difference, e.g. Belytschko,
 // Liu & Moran, Nonlinear Finite Elements, section 6.3).
 double ContinuumSolver::critical_time_step() const {
-  for (double m : mass_)
+  for (double m : dof_mass_)
     if (!(m > 0)) throw RunError("continuum: a lumped mass is not positive (weight without floor?)");
   const size_t n = u_.size();
   Field x(n), y, scaled(n);
@@ -509,11 +515,11 @@ double ContinuumSolver::critical_time_step() const {
     double nx = 0;
     for (double xi : x) nx += xi * xi;
     nx = std::sqrt(nx);
-    for (size_t d = 0; d < n; ++d) scaled[d] = x[d] / nx / std::sqrt(mass_[d / 3]);
+    for (size_t d = 0; d < n; ++d) scaled[d] = x[d] / nx / std::sqrt(dof_mass_[d]);
     stiffness().multiply(scaled, y);
     double rq = 0;
     for (size_t d = 0; d < n; ++d) {
-      y[d] /= std::sqrt(mass_[d / 3]);
+      y[d] /= std::sqrt(dof_mass_[d]);
       rq += y[d] * x[d] / nx;
     }
     const bool converged = it > 50 && std::abs(rq - lambda) <= 1e-7 * rq;
@@ -670,8 +676,8 @@ double ContinuumSolver::strain_energy() const {
 double ContinuumSolver::kinetic_energy(double kick) const {
   double e = 0;
   for (size_t d = 0; d < v_.size(); ++d) {
-    const double v = is_fixed_[d] ? v_[d] : v_[d] + kick * f_[d] / mass_[d / 3];
-    e += 0.5 * mass_[d / 3] * v * v;
+    const double v = is_fixed_[d] ? v_[d] : v_[d] + kick * f_[d] / dof_mass_[d];
+    e += 0.5 * dof_mass_[d] * v * v;
   }
   return e;
 }

@@ -84,6 +84,9 @@ class ContinuumSolver {
   // Arlequin weight; recomputes the lumped mass and the point weights.
   void set_weight(ScalarFunction alpha);
   const std::vector<double>& lumped_mass() const { return mass_; }  // per node, weighted
+  // Per dof: the node's lumped mass times the material's inertia share along the dof's axis;
+  // the mass the dynamics use (kicks, kinetic energy, critical step, coupling).
+  const std::vector<double>& dof_mass() const { return dof_mass_; }
 
   // Consistency of a weighted quadrature (the Arlequin overlap's consistent quadrature,
   // coupling/coupled_model.hpp). Under a uniform stress sigma the weighted internal force of
@@ -252,6 +255,8 @@ class ContinuumSolver {
   mutable bool stiffness_current_ = false;
   mutable Field ku_;
   std::vector<double> mass_;
+  Vec3 inertia_{1.0, 1.0, 1.0};  // the materials' (one for all), Material::inertia
+  std::vector<double> dof_mass_;
   std::vector<Fixed> fixed_;
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)
   std::vector<char> is_fixed_;  // per dof

@@ -16,6 +16,10 @@ using Stiffness = Eigen::Matrix<double, 6, 6>;
 struct Material {
   Stiffness C = Stiffness::Zero();
   double density = 0.0;
+  // The share of the mass that a motion along x, y, z carries (1 each: a solid). A homogenised
+  // dry weave, whose yarn families slide along each other, moves only its x-running yarns along
+  // x (docs/theory.md#directional-inertia).
+  Vec3 inertia{1.0, 1.0, 1.0};
 
   // InputError unless E > 0, -1 < nu < 0.5, density > 0.
   static Material isotropic(double E, double nu, double density);

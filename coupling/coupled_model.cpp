@@ -70,6 +70,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
     });
   }
   ops_ = CouplingOperators::build(zone_, dem_.particles, continuum_, options_.coupling);
+  if (!options_.tied_components.empty()) ops_.tie_components(options_.tied_components);
   if (options_.consistent_quadrature) make_overlap_quadrature_consistent();
   continuum_.compute_forces();
   const int np = ops_.num_particles(), nn = continuum_.num_nodes();
@@ -82,7 +83,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
     inv_mass_d_[p] = driven[i] ? 0.0 : dem_.particles.inv_mass[i];
   }
   inv_mass_c_.resize(3 * static_cast<size_t>(nn));
-  for (int d = 0; d < 3 * nn; ++d) inv_mass_c_[d] = 1.0 / continuum_.lumped_mass()[d / 3];
+  for (int d = 0; d < 3 * nn; ++d) inv_mass_c_[d] = 1.0 / continuum_.dof_mass()[d];
   for (int d : options_.held_continuum_dofs) inv_mass_c_.at(d) = 0.0;
   solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_, options_.multiplier_petsc_options);
 
@@ -278,7 +279,8 @@ CouplingMonitor CoupledModel::monitor() const {
   CouplingMonitor m;
   m.constraint_residual = relative(residual);
   m.drift_residual = relative(drift_residual_);
-  const Matrix3 mismatch = ops_.N * vc - vd;
+  Matrix3 mismatch = ops_.N * vc - vd;
+  if (ops_.tied.size()) mismatch.array() *= ops_.tied.array();  // free components may differ
   const Eigen::Index n = mismatch.rows();
   double sum = 0.0, largest = 0.0;
   for (Eigen::Index p = 0; p < n; ++p) {

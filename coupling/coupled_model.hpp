@@ -100,6 +100,8 @@ struct CoupledOptions {
   bool hold_overlap_failures = false;
   // The continuum's internal force evaluated every this many steps (coupling.continuum_substeps).
   int continuum_substeps = 1;
+  // Per DE of the scene, the components its coupling holds (coupling.ties); empty: all three.
+  std::vector<std::array<bool, 3>> tied_components;
 };
 
 // The dofs of a continuum physical group (for held_continuum_dofs).
@@ -134,7 +136,7 @@ struct CoupledEnergies {
 struct CouplingMonitor {
   double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d| after the last correction
   double drift_residual = 0.0;         // the same for the drift velocities v(n+1/2)
-  double velocity_mismatch = 0.0;      // rms over coupled DEs of |v_p - (N v_c)(x_p)|, m/s
+  double velocity_mismatch = 0.0;      // rms over coupled DEs of |v_p - (N v_c)(x_p)| (held components), m/s
   double max_velocity_mismatch = 0.0;  // max of the same, m/s
 };
 

@@ -200,4 +200,12 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
   return op;
 }
 
+void CouplingOperators::tie_components(const std::vector<std::array<bool, 3>>& components) {
+  if (settings.mediator != Mediator::fine || settings.type != CouplingType::l2)
+    throw SettingError("ties", "ties of some components need the fine mediator and l2 coupling (a row per DE)");
+  tied.resize(num_particles(), 3);
+  for (int p = 0; p < num_particles(); ++p)
+    for (int c = 0; c < 3; ++c) tied(p, c) = components.at(particles[static_cast<std::size_t>(p)])[static_cast<std::size_t>(c)] ? 1.0 : 0.0;
+}
+
 }  // namespace arlequin::coupling

@@ -33,7 +33,9 @@
 //  - Kinematic patch test: for any affine field u(x), u_p = u(x_p) and u_I = u(X_I) give
 //    G_d u_d + G_c u_c = 0 to round-off (N reproduces affine fields, D is exact for them).
 #pragma once
+#include <Eigen/Dense>
 #include <Eigen/Sparse>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -68,10 +70,18 @@ struct CouplingOperators {
   SparseMatrix N;                        // particles x continuum nodes
   SparseMatrix Gd;                       // rows x particles
   SparseMatrix Gc;                       // rows x continuum nodes
+  // Which components of each row the constraint holds (1) or leaves free (0); empty: all.
+  // Set by tie_components; MultiplierSolver drops the free ones (no multiplier, no correction).
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> tied;
 
   // InputError if no DE lies in the overlap or the H1 settings are invalid.
   static CouplingOperators build(const OverlapZone& zone, const dem::ParticleSet& particles,
                                  const continuum::ContinuumSolver& continuum, const CouplingSettings& settings);
+  // Partial ties (fine mediator, L2: a row is one DE): the components of DE i that follow the
+  // continuum are components[i] (indexed by the scene's DEs); the others move with the DEM alone.
+  // A woven plate moves each yarn family along its own axis only (docs/theory.md#partial-ties).
+  // SettingError("ties") for another mediator or coupling type.
+  void tie_components(const std::vector<std::array<bool, 3>>& components);
   int rows() const { return static_cast<int>(Gd.rows()); }
   int num_particles() const { return static_cast<int>(particles.size()); }
 };

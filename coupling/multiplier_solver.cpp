@@ -68,8 +68,8 @@ bool is_diagonal(const SparseMatrix& G) {
 
 }  // namespace
 
-std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const Eigen::VectorXd& md,
-                                                                            const Eigen::VectorXd& mc) const {
+std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc,
+                                                                            int component) const {
   const CouplingOperators& ops = *ops_;
   if (ops.settings.mediator != Mediator::fine || ops.settings.type != CouplingType::l2 || !is_diagonal(ops.Gd)) return nullptr;
   const int rows = ops.rows();
@@ -86,7 +86,8 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
   int k = 0;
   std::vector<Eigen::Triplet<double>> t;
   std::vector<double> masses;
-  for (int r = 0; r < rows; ++r)
+  for (int r = 0; r < rows; ++r) {
+    if (!is_tied(r, component)) continue;  // a free row's U row is empty: its multiplier stays 0
     for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it) {
       const auto j = static_cast<std::size_t>(it.col());
       if (mc[it.col()] == 0.0) continue;
@@ -96,6 +97,7 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const
       }
       t.emplace_back(r, reduced[j], it.value());
     }
+  }
   a->U.resize(rows, k);
   a->U.setFromTriplets(t.begin(), t.end());
   a->Ut = RowMajorMatrix(a->U.transpose());
@@ -134,8 +136,9 @@ void MultiplierSolver::solve_low_rank(const LowRank& a, double* x) const {
 }
 
 int MultiplierSolver::system_of_earlier_component(int c) const {
+  const auto& tied = ops_->tied;
   for (int b = 0; b < c; ++b)
-    if (inv_c_.col(b) == inv_c_.col(c)) return factor_of_[b];
+    if (inv_c_.col(b) == inv_c_.col(c) && (tied.size() == 0 || tied.col(b) == tied.col(c))) return factor_of_[b];
   return -1;
 }
 
@@ -156,7 +159,7 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
         factor_of_[c] = same;
         continue;
       }
-      auto a = low_rank_form(inv_d_.col(c), inv_c_.col(c));
+      auto a = low_rank_form(inv_d_.col(c), inv_c_.col(c), c);
       if (!a) {
         low_rank_.clear();
         break;
@@ -173,8 +176,12 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
       continue;
     }
     const Eigen::VectorXd md = inv_d_.col(c), mc = inv_c_.col(c);
-    const SparseMatrix A = ops.Gd * md.asDiagonal() * SparseMatrix(ops.Gd.transpose()) +
-                           ops.Gc * mc.asDiagonal() * SparseMatrix(ops.Gc.transpose());
+    Eigen::VectorXd tie = Eigen::VectorXd::Ones(ops.rows());  // free rows empty: their multipliers 0 (below)
+    for (int r = 0; r < ops.rows(); ++r) tie[r] = is_tied(r, c) ? 1.0 : 0.0;
+    const SparseMatrix A = tie.asDiagonal() *
+                           SparseMatrix(ops.Gd * md.asDiagonal() * SparseMatrix(ops.Gd.transpose()) +
+                                        ops.Gc * mc.asDiagonal() * SparseMatrix(ops.Gc.transpose())) *
+                           tie.asDiagonal();
     // Jacobi scaling S A S, S = diag(A)^-1/2: rows of A differ by orders of magnitude (a
     // floored continuum mass on the overlap edge against a full one), and the pivot test below
     // is only meaningful on a unit diagonal.
@@ -270,6 +277,7 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
   out.resize(ops_->rows(), 3);
   multiply<3>(ops_->Gd, vd.data(), 3, out.data());
   multiply<3>(ops_->Gc, vc.data(), vc.outerStride(), out.data(), true);
+  if (ops_->tied.size()) out.array() *= ops_->tied.array();
 }
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {

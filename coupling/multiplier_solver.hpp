@@ -18,6 +18,10 @@
 //  - No allocation per call once the outputs have their sizes (rows x 3, DEs x 3, nodes x 3):
 //    the explicit step calls these every step; scratch lives in the solver (one solver per
 //    coupled model, not shared between threads).
+//  - Partial ties (CouplingOperators::tied): a row's free components are left out of that
+//    component's system (an empty row of A, a zero row of U) and of the residual, so their
+//    multipliers are 0 and those velocities are not corrected. Components with the same masses
+//    and the same ties share a system.
 //  - RunError if A is not positive definite (e.g. a coarse mediator with too few DEs per
 //    element to fix every mediator node; the message suggests the fine mediator).
 //  - With the fine mediator and L2 coupling G_d = W is diagonal and G_c = -W N, so
@@ -63,7 +67,7 @@ class MultiplierSolver {
 
   // A lambda = rhs per component (rhs, lambda: rows x 3).
   void solve(const Matrix3& rhs, Matrix3& lambda) const;
-  // out = G_d vd + G_c vc (rows x 3).
+  // out = G_d vd + G_c vc (rows x 3), 0 in the components a row leaves free.
   void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
@@ -89,12 +93,14 @@ class MultiplierSolver {
   };
   // The low-rank form of A for inverse masses (md, mc), or nullptr when it does not apply or its
   // set-up residual check fails.
-  std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc) const;
+  std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc, int component) const;
+  // Whether the constraint holds row r's component c (CouplingOperators::tied).
+  bool is_tied(int r, int c) const { return ops_->tied.size() == 0 || ops_->tied(r, c) != 0.0; }
   // x = A^-1 x for `width` components (rows x width, row-major).
   template <int width>
   void solve_low_rank(const LowRank& a, double* x) const;
-  // The system of an earlier component with the same continuum inverse masses (the DEs' are the
-  // same for all three components), or -1.
+  // The system of an earlier component with the same continuum inverse masses and ties (the DEs'
+  // masses are the same for all three components), or -1.
   int system_of_earlier_component(int c) const;
 
   const CouplingOperators* ops_;

@@ -272,6 +272,7 @@ WeaveReport build_weave(DemModel& model, const WeaveSpec& s, const std::function
         p.inv_mass[id[n]] = 1.0 / de_mass;
       }
     report.mass += yarn_mass;
+    report.family_mass[y.family] += yarn_mass;
   }
 
   // Springs along every chain, one set per family.

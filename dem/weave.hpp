@@ -29,6 +29,7 @@
 // field when the weave cannot be built as asked (a yarn too thin for its chains, binders that
 // cross the weft at the given crimp), before anything is added.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <stdexcept>
@@ -69,6 +70,7 @@ struct WeaveReport {
   double radius = 0.0;                             // DE radius R, m
   double spring_stiffness = 0.0;                   // K of a spring of rest length 2R, N/m
   double mass = 0.0;                               // of all yarns, kg
+  std::array<double, 3> family_mass{};             // of the weft, stuffer and binder yarns, kg
   std::size_t des = 0, springs = 0;
   std::size_t des_not_kept = 0;                    // refused by build_weave's keep
   double deepest_overlap = 0.0;                    // over 2R, of two DEs not joined by a spring

@@ -31,6 +31,14 @@ CouplingOperators one_to_one(const std::vector<double>& w) {
   return ops;
 }
 
+// Velocities of one_to_one's four rows (DEs and nodes), mixed in sign and size.
+void four_row_velocities(Matrix3& vd, Matrix3& vc) {
+  vd.resize(4, 3);
+  vc.resize(4, 3);
+  vd << 1, 2, 3, -1, 0.5, 2, 4, -3, 1, 0.2, 0.3, -0.7;
+  vc << -2, 1, 0, 3, 1.5, -1, 2, 2, 2, -0.4, 0.9, 0.1;
+}
+
 // nullopt: our LDL^T; a string: PETSc with these options.
 const std::optional<std::string> backends[] = {std::nullopt, std::string(), std::string("-ksp_type cg -pc_type jacobi -ksp_rtol 1e-14")};
 
@@ -50,9 +58,8 @@ TEST(CouplingMultiplierSolver, ProjectionIsTheMomentumWeightedMeanAndAHeldRowIsE
   EXPECT_EQ(solver.systems(), 2) << solver.backend();  // y differs from x, z reuses x's system
   EXPECT_EQ(solver.backend(), !backend ? "LDL^T" : backend->empty() ? "PETSc preonly + cholesky" : "PETSc cg + jacobi");
 
-  Matrix3 vd(4, 3), vc(4, 3), dd, dc, lambda;
-  vd << 1, 2, 3, -1, 0.5, 2, 4, -3, 1, 0.2, 0.3, -0.7;
-  vc << -2, 1, 0, 3, 1.5, -1, 2, 2, 2, -0.4, 0.9, 0.1;
+  Matrix3 vd, vc, dd, dc, lambda;
+  four_row_velocities(vd, vc);
   const Matrix3 vd0 = vd, vc0 = vc;
   solver.project(vd, vc, dd, dc, lambda);
   for (int i = 0; i < 4; ++i)
@@ -90,12 +97,14 @@ TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
     EXPECT_THROW(MultiplierSolver(ops, {1.0}, {1.0, 1.0, 1.0}, backend), RunError) << (backend ? "PETSc " + *backend : "LDL^T");
 }
 
-// The fine mediator (G_d = W diagonal, G_c = -W N) is solved by the Woodbury form; the same
-// matrices through the general LDL^T (the operators marked coarse, which that path does not
-// look at) give the same multipliers to round-off, both project onto ker G, and a held node
-// (inverse mass 0 in one component) keeps its velocity. 30 DEs, 8 nodes, each DE interpolated
-// from three nodes with positive weights summing to 1.
-TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFactor) {
+namespace {
+// 30 DEs on 8 nodes, fine mediator, each DE interpolated from three nodes with positive weights
+// summing to 1; node 2 held along y.
+struct SharedNodes {
+  CouplingOperators fine;
+  std::vector<double> md, mc;
+};
+SharedNodes shared_nodes() {
   const int np = 30, nn = 8;
   CouplingOperators fine;
   fine.settings.mediator = Mediator::fine;
@@ -118,6 +127,17 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   }
   for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * (d / 3)));  // node masses ~5 mg
   mc[3 * 2 + 1] = 0.0;  // node 2 held along y
+  return {fine, md, mc};
+}
+}  // namespace
+
+// The fine mediator (G_d = W diagonal, G_c = -W N) is solved by the Woodbury form; the same
+// matrices through the general LDL^T (the operators marked coarse, which that path does not
+// look at) give the same multipliers to round-off, both project onto ker G, and a held node
+// (inverse mass 0 in one component) keeps its velocity (shared_nodes above).
+TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFactor) {
+  const auto [fine, md, mc] = shared_nodes();
+  const int np = fine.num_particles(), nn = static_cast<int>(fine.Gc.cols());
   CouplingOperators general = fine;
   general.settings.mediator = Mediator::coarse;
   const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
@@ -136,4 +156,76 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   woodbury.residual(vd_w, vc_w, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
   EXPECT_EQ(vc_w(2, 1), vc(2, 1));                      // the held dof
+}
+
+// Partial ties (CouplingOperators::tied): in a component a row leaves free there is no
+// multiplier and both velocities stay; in the held ones they meet at the momentum-weighted mean
+// (one_to_one's closed form). The masses are the same in x, y and z, the ties are not: three
+// systems. Through the general factor with each backend, and the Woodbury form (fine mediator).
+TEST(CouplingMultiplierSolver, AFreeComponentKeepsItsVelocitiesAndTheHeldOnesMeet) {
+  const std::vector<double> w{0.5, 1.0, 2.0, 0.25}, md{1.0, 2.0, 0.5, 4.0};
+  std::vector<double> mc;
+  for (int i = 0; i < 4; ++i)
+    for (int c = 0; c < 3; ++c) mc.push_back(0.5 + 0.25 * i);
+  const bool held[4][3] = {{true, false, true}, {false, true, true}, {false, false, true}, {true, true, true}};
+  for (int pass = 0; pass < 4; ++pass) {
+    CouplingOperators ops = one_to_one(w);
+    const bool woodbury = pass == 3;
+    ops.settings.mediator = Mediator::fine;
+    std::vector<std::array<bool, 3>> components(4);
+    for (int i = 0; i < 4; ++i) components[i] = {held[i][0], held[i][1], held[i][2]};
+    ops.tie_components(components);
+    if (!woodbury) ops.settings.mediator = Mediator::coarse;  // the general factor, which does not look at it
+    const MultiplierSolver solver(ops, md, mc, woodbury ? std::nullopt : backends[pass]);
+    EXPECT_EQ(solver.systems(), 3) << solver.backend();
+    EXPECT_EQ(solver.backend().rfind("diagonal + low rank (Woodbury)", 0) == 0, woodbury) << solver.backend();
+    Matrix3 vd, vc, dd, dc, lambda, residual;
+    four_row_velocities(vd, vc);
+    const Matrix3 vd0 = vd, vc0 = vc;
+    solver.project(vd, vc, dd, dc, lambda);
+    for (int i = 0; i < 4; ++i)
+      for (int c = 0; c < 3; ++c) {
+        if (!held[i][c]) {
+          EXPECT_EQ(lambda(i, c), 0.0) << pass << i << c;
+          EXPECT_EQ(vd(i, c), vd0(i, c)) << pass << i << c;
+          EXPECT_EQ(vc(i, c), vc0(i, c)) << pass << i << c;
+          continue;
+        }
+        const double a = md[i], b = mc[3 * i + c];
+        const double mean = (vd0(i, c) / a + vc0(i, c) / b) / (1 / a + 1 / b);
+        EXPECT_NEAR(lambda(i, c), (vd0(i, c) - vc0(i, c)) / (w[i] * (a + b)), 1e-12) << pass << i << c;
+        EXPECT_NEAR(vd(i, c), mean, 1e-12) << pass << i << c;
+        EXPECT_NEAR(vc(i, c), mean, 1e-12) << pass << i << c;
+      }
+    solver.residual(vd0, vc0, residual);  // the free components are not part of the residual
+    for (int i = 0; i < 4; ++i)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(residual(i, c) == 0.0, !held[i][c]) << i << c;
+  }
+  // Ties need a row per DE.
+  CouplingOperators coarse = one_to_one(w);
+  EXPECT_THROW(coarse.tie_components(std::vector<std::array<bool, 3>>(4, {true, true, false})), SettingError);
+
+  // Nodes shared by held and free rows (shared_nodes): the Woodbury form leaves the free rows out
+  // of its K as the general factor leaves them out of A; both give the same multipliers.
+  auto [fine, md_s, mc_s] = shared_nodes();
+  std::vector<std::array<bool, 3>> ties(static_cast<std::size_t>(fine.num_particles()));
+  for (std::size_t p = 0; p < ties.size(); ++p) ties[p] = {p % 3 != 0, p % 3 != 1, true};
+  fine.tie_components(ties);
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;
+  const MultiplierSolver woodbury(fine, md_s, mc_s, std::nullopt), factor(general, md_s, mc_s, std::nullopt);
+  EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
+  Matrix3 vd(fine.num_particles(), 3), vc(fine.Gc.cols(), 3), dd, dc, lambda_w, lambda_f;
+  for (int p = 0; p < vd.rows(); ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
+  for (int i = 0; i < vc.rows(); ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
+  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc;
+  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
+  factor.project(vd_f, vc_f, dd, dc, lambda_f);
+  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
+  EXPECT_LT((vc_w - vc_f).norm(), 1e-10 * vc.norm());
+  for (std::size_t p = 0; p < ties.size(); ++p)
+    for (int c = 0; c < 3; ++c) {
+      if (ties[p][static_cast<std::size_t>(c)]) continue;
+      EXPECT_EQ(vd_w(static_cast<Eigen::Index>(p), c), vd(static_cast<Eigen::Index>(p), c)) << p << c;
+    }
 }

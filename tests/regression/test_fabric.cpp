@@ -158,8 +158,8 @@ std::vector<std::map<std::string, std::string>> run_coupled(const std::string& n
 }
 
 // Without breakage: the balance (both models and the multipliers' work) stays within 6e-4 of the
-// impact energy (measured 4.1e-4 with the case's plate force once every 6 steps: velocity Verlet's
-// error of the plate at its macro step, theory.md#continuum-substeps; 8.2e-5 every step), the
+// impact energy (measured 4.1e-4 with the case's plate force once every 4 steps: velocity Verlet's
+// error of the plate at its macro step, theory.md#continuum-substeps; 8.0e-5 every step), the
 // multipliers do no work (1e-12 of it; measured 1.6e-17), and the plate takes its share
 // (measured 0.45 J at 40 us; bound 0.1 J).
 TEST(FabricCoupled, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
@@ -178,29 +178,34 @@ TEST(FabricCoupled, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
   EXPECT_GT(at(rows.back(), "C_kinetic") + at(rows.back(), "C_strain"), 0.1);
 }
 
-// The plate's internal force once every 6 steps (reduced.yaml's continuum_substeps, r-RESPA's
-// impulses) against every step, without breakage: the sphere's velocity follows the every-step
-// run within 0.5 % of its 90 m/s (measured 0.15 %), the plate's peak strain energy within 1 %
-// (measured -0.27 %), and the every-step run's balance stays within 2e-4 of the impact energy
-// (measured 8.2e-5).
-TEST(FabricCoupled, ThePlateForcedEverySixthStepFollowsTheEveryStepRun) {
+// The plate's internal force once every 4 steps (reduced.yaml's continuum_substeps, r-RESPA's
+// impulses) against every step, without breakage. The weave's contacts make the run sensitive:
+// the every-step run with a step 0.3 % shorter moves the sphere's velocity by 0.26 m/s and the
+// plate's peak strain energy by 1.9 % (without the ties and the plate's directional inertia,
+// 0.29 m/s and 1.2 %), so the bounds sit above that floor: the velocity within 0.75 m/s of the
+// every-step run's (measured 0.46), the peak strain energy within 3 % (measured -1.9 %), the
+// sub-cycled run's balance within 6e-4 of the impact energy (measured 4.1e-4) and the every-step
+// run's within 2e-4 (measured 8.0e-5). An opening impulse of 0.6 m dt instead of 0.5 leaves 15 %
+// of the strain energy out and the balance 15 times the impact energy.
+TEST(FabricCoupled, ThePlateForcedEveryFourthStepFollowsTheEveryStepRun) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
   std::filesystem::path out;
-  const auto substeps = run_coupled("fabric_coupled_substeps_6", " --set dem.sample.yarn.failure_strain=0", out);
+  const auto substeps = run_coupled("fabric_coupled_substeps_4", " --set dem.sample.yarn.failure_strain=0", out);
   const auto every_step = run_coupled("fabric_coupled_substeps_1",
                                       " --set dem.sample.yarn.failure_strain=0 --set coupling.continuum_substeps=1", out);
   ASSERT_EQ(substeps.size(), every_step.size());
   ASSERT_FALSE(substeps.empty());
-  double velocity = 0.0, peak_6 = 0.0, peak_1 = 0.0;
+  double velocity = 0.0, peak_4 = 0.0, peak_1 = 0.0;
   for (std::size_t k = 0; k < substeps.size(); ++k) {
     velocity = std::max(velocity, std::abs(at(substeps[k], "sphere_velocity") - at(every_step[k], "sphere_velocity")));
-    peak_6 = std::max(peak_6, at(substeps[k], "C_strain"));
+    peak_4 = std::max(peak_4, at(substeps[k], "C_strain"));
     peak_1 = std::max(peak_1, at(every_step[k], "C_strain"));
   }
-  EXPECT_LT(velocity, 0.005 * 90.0);
-  EXPECT_NEAR(peak_6 / peak_1, 1.0, 0.01);
+  EXPECT_LT(velocity, 0.75);
+  EXPECT_NEAR(peak_4 / peak_1, 1.0, 0.03);
+  EXPECT_LT(worst_balance(substeps), 6e-4 * impact_energy());
   EXPECT_LT(worst_balance(every_step), 2e-4 * impact_energy());
 }
 
@@ -239,9 +244,11 @@ TEST(FabricCoupled, ReducedImpactHoldsTheOverlapsSpringsAndTheFractureClosesTheB
 }
 
 // cases/fabric_impact_coupled/yarn_pulse.yaml: a pulse 8 mm long along the weft yarns leaves the
-// DEM through the overlap into the plate; the case's check bounds what comes back at 6 % (measured
-// 5.2 %; the plate's impedance step alone reflects 3.4 %, README.md). With the coarse mediator the
-// yarns slide through the overlap's elements and 31 % comes back: the test can tell.
+// DEM through the overlap into the plate; the case's check bounds what comes back at 4.5 % (measured
+// 3.5 %, with the plate's inertia along x the weft's and each yarn family held along its own axis).
+// Every DE of the overlap held along x (no ties) puts the stuffers' and binders' mass on the weft's
+// motion there: 8.1 % comes back. With the coarse mediator the yarns slide through the overlap's
+// elements and 31 % comes back.
 TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -253,21 +260,23 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
     return std::make_pair(r.exit_code, summary.at("checks").at(0).at("value").get<double>());
   };
   const auto [code, R] = reflected("fabric_yarn_pulse", "");
-  EXPECT_EQ(code, 0);  // the case's own check: R <= 0.06
-  EXPECT_LT(R, 0.06);
-  EXPECT_GT(R, 0.02);  // the impedance step is there
-  const auto [coarse_code, coarse_R] = reflected("fabric_yarn_pulse_coarse", " --set coupling.mediator=coarse");
+  EXPECT_EQ(code, 0);  // the case's own check: R <= 0.045
+  EXPECT_LT(R, 0.045);
+  const auto [untied_code, untied_R] = reflected("fabric_yarn_pulse_untied", " --set coupling.ties=[]");
+  EXPECT_EQ(untied_code, 5);  // its check failed
+  EXPECT_GT(untied_R, 0.07);
+  const auto [coarse_code, coarse_R] = reflected("fabric_yarn_pulse_coarse", " --set coupling.mediator=coarse --set coupling.ties=[]");
   EXPECT_EQ(coarse_code, 5);  // its check failed
   EXPECT_GT(coarse_R, 0.2);
 }
 
 // Validation: the coupled seed target against the pure-DEM run (`arlequin compare`, both with
-// breakage, about 30 s): the bounds, the sphere's velocity history within 5 % (max
-// relative over the 100 us; measured 4.72 % of its largest value), the peak impact force within
-// 10 % (measured -7.65 %), the first break within 10 % (measured -5.99 %); and without breakage
-// the coupled balance within 1 % of the impact energy (measured 2.8e-4). With breakage the
-// differences move with the last bits of the arithmetic (0.92 %, +2.75 %, -0.34 % on another
-// machine): the case's README says what a breaking weave's comparison can resolve.
+// breakage, about 40 s): the bounds, the sphere's velocity history within 5 % (max
+// relative over the 100 us; measured 2.03 % of its largest value), the peak impact force within
+// 10 % (measured -1.25 %, rows every 0.1 us), the first break within 10 % (measured -1.47 %); and
+// without breakage the coupled balance within 1 % of the impact energy (measured 2.9e-4). With
+// breakage the differences move with the last bits of the arithmetic: the case's README says what
+// a breaking weave's comparison can resolve.
 TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -299,7 +308,7 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 
 // Validation: the 44 x 100 mm target, run once in pure DEM (143 944 DEs, about 60 s) and coupled
 // (the same patch in a larger plate). Only what holds is asserted: both complete, and the coupled
-// balance closes with the fracture energy within 1 % of the impact energy (measured 2.8e-4). The
+// balance closes with the fracture energy within 1 % of the impact energy (measured 6.7e-4). The
 // comparison itself misses the bounds (cases/fabric_impact_coupled/README.md says why).
 TEST(ValidationFabric, LargerTargetRunsPureAndCoupled) {
 #ifndef ARLEQUIN_WITH_CONTINUUM

@@ -107,6 +107,7 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
   read_case(cases + "fabric_impact/reduced.yaml",
             {"dem.sample.crimp=0.7", "dem.sample.yarn.section=2.0e-7", "dem.contact.stiffness=1.0e7", "dem.gravity=[0, 0, -9.81]"}, dir_);
   read_case(cases + "yarn_wave/case.yaml", {}, dir_);
+  read_case(cases + "fabric_impact_coupled/reduced.yaml", {}, dir_);  // its ties
 
   std::ofstream(dir_ / "des.csv") << "x,y,z,radius\n0,0,0,0.001\n0.002,0,0,0.001\n";
   std::ofstream(dir_ / "table.yaml") << "time: {end: 1.0e-6, dt: 1.0e-8}\ndem:\n  density: 7800\n"

@@ -82,6 +82,10 @@ TEST(Weave, CountsLengthsMassAndArealDensityMatchTheClosedForms) {
   for (std::size_t i = 0; i < model.particles.size(); ++i) mass += model.particles.mass(i);
   const double closed = s.density * s.section * (12 * 6e-3 + 6 * 8e-3 + 2 * Lb);
   EXPECT_NEAR(mass / closed, 1.0, 1e-4);
+  // Per family (the plate's inertia shares): 12 weft yarns of 6 mm, 6 stuffers of 8 mm (exact),
+  // 2 binders of Lb (the quadrature above, hence the total's tolerance).
+  const double family[3] = {12 * 6e-3, 6 * 8e-3, 2 * Lb};
+  for (int f = 0; f < 3; ++f) EXPECT_NEAR(r.family_mass[f] / (s.density * s.section * family[f]), 1.0, f < 2 ? 1e-12 : 1e-4) << f;
   EXPECT_NEAR(r.areal_density / (closed / (6e-3 * 8e-3)), 1.0, 1e-4);
   EXPECT_NEAR(r.thickness, 2 * r.amplitude + s.yarn_thickness, 1e-15);
   EXPECT_NEAR(r.fibre_volume_fraction * 6e-3 * 8e-3 * r.thickness / (s.section * (12 * 6e-3 + 6 * 8e-3 + 2 * Lb)), 1.0, 1e-4);
