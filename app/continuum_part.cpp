@@ -353,7 +353,7 @@ CouplingCaseSettings read_coupling(CaseNode section) {
     out.ties.push_back({tie, tie.string("group"), read_components(tie)});
     tie.finish();
   }
-  if (!out.ties.empty() && (out.options.coupling.mediator != coupling::Mediator::fine || out.options.coupling.type != coupling::CouplingType::l2))
+  if (!out.ties.empty() && !out.options.coupling.fine_l2())
     section.fail("ties", "ties of some components need mediator: fine and type: l2 (a multiplier per DE)");
   static constexpr std::string_view quadratures[] = {"plain", "consistent"};
   out.options.consistent_quadrature = section.choice_or("quadrature", "plain", quadratures) == "consistent";

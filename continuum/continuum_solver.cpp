@@ -94,9 +94,8 @@ ContinuumSolver::ContinuumSolver(const ContinuumSettings& settings)
   if (std::find(tet_material_.begin(), tet_material_.end(), -1) != tet_material_.end())
     throw InputError("continuum: some tetrahedra lie in no region with a material");
   // A node on the face between two materials would need a mix of their shares; one share for all.
-  inertia_ = materials_.front().inertia;
   for (const Material& m : materials_)
-    if (!(m.inertia == inertia_)) throw InputError("continuum: the materials' inertia shares differ (one set for all materials)");
+    if (!(m.inertia == materials_.front().inertia)) throw InputError("continuum: the materials' inertia shares differ (one set for all materials)");
   const size_t ndof = 3 * static_cast<size_t>(mesh_.num_nodes());
   u_.assign(ndof, 0.0);
   v_.assign(ndof, 0.0);
@@ -119,8 +118,9 @@ void ContinuumSolver::set_weight(ScalarFunction alpha) {
   point_weight_.resize(points_.x.size());
   for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
   mass_ = weighted_lumped_mass(alpha_);
+  const Vec3& share = materials_.front().inertia;  // the same for every material (constructor)
   dof_mass_.resize(3 * mass_.size());
-  for (std::size_t d = 0; d < dof_mass_.size(); ++d) dof_mass_[d] = mass_[d / 3] * inertia_[static_cast<int>(d % 3)];
+  for (std::size_t d = 0; d < dof_mass_.size(); ++d) dof_mass_[d] = mass_[d / 3] * share[static_cast<int>(d % 3)];
   stiffness_current_ = false;
 }
 

@@ -255,7 +255,6 @@ class ContinuumSolver {
   mutable bool stiffness_current_ = false;
   mutable Field ku_;
   std::vector<double> mass_;
-  Vec3 inertia_{1.0, 1.0, 1.0};  // the materials' (one for all), Material::inertia
   std::vector<double> dof_mass_;
   std::vector<Fixed> fixed_;
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)

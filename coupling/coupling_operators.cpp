@@ -201,7 +201,7 @@ CouplingOperators CouplingOperators::build(const OverlapZone& zone, const dem::P
 }
 
 void CouplingOperators::tie_components(const std::vector<std::array<bool, 3>>& components) {
-  if (settings.mediator != Mediator::fine || settings.type != CouplingType::l2)
+  if (!settings.fine_l2())
     throw SettingError("ties", "ties of some components need the fine mediator and l2 coupling (a row per DE)");
   tied.resize(num_particles(), 3);
   for (int p = 0; p < num_particles(); ++p)

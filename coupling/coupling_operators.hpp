@@ -58,6 +58,8 @@ struct CouplingSettings {
   CouplingType type = CouplingType::l2;
   double length = 0.0;           // H1 length scale l, m (> 0 for H1)
   double gradient_radius = 0.0;  // H1 gradient neighbourhood, m; 0 = 1.5 x the median nearest-DE distance
+  // A multiplier per DE and G_d = W diagonal: what partial ties and the Woodbury form need.
+  bool fine_l2() const { return mediator == Mediator::fine && type == CouplingType::l2; }
 };
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;

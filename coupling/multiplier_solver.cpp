@@ -71,7 +71,7 @@ bool is_diagonal(const SparseMatrix& G) {
 std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc,
                                                                             int component) const {
   const CouplingOperators& ops = *ops_;
-  if (ops.settings.mediator != Mediator::fine || ops.settings.type != CouplingType::l2 || !is_diagonal(ops.Gd)) return nullptr;
+  if (!ops.settings.fine_l2() || !is_diagonal(ops.Gd)) return nullptr;
   const int rows = ops.rows();
   auto a = std::make_unique<LowRank>();
   a->inv_D.resize(rows);
