@@ -10,7 +10,11 @@
 // against one thread (common/step_profile.hpp).
 // The same for a virtual test run to its end (the REV failure test): --virtual-test SPEC --sample
 // NAME --test NAME times the test's time loop (sensors and rows included) the same way.
-// Usage: bench_bonded_block [--steps N] [--threads 1,2,4,...] [--repeat R] [--profile] [--set k=v ...] [CASE.yaml]
+// With --kernel, the beam sets' block kernel alone on one thread (docs/performance.md#beam-kernel):
+// over the set's bonds in the case's configuration, over one block's bonds again and again (their
+// data in the first-level cache: the kernel's own cost), and the whole force pass (kernel, stored
+// actions and each DE's sum); the fastest of five runs each, as nothing makes a run faster than it is.
+// Usage: bench_bonded_block [--steps N] [--threads 1,2,4,...] [--repeat R] [--profile] [--kernel] [--set k=v ...] [CASE.yaml]
 //        bench_bonded_block --virtual-test SPEC --sample NAME --test NAME [--threads ...] [--repeat R] [--profile] [--set k=v ...]
 #ifdef _OPENMP
 #include <omp.h>
@@ -33,6 +37,7 @@
 #include "app/virtual_tests.hpp"
 #include "common/error.hpp"
 #include "common/step_profile.hpp"
+#include "dem/bonds/beam_bond.hpp"
 
 namespace {
 
@@ -63,6 +68,7 @@ struct Options {
   std::vector<int> threads{1, 2};
   int repeat = 1;
   bool profile = false;
+  bool kernel = false;
   std::string case_file = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/bonded_block_tension/case.yaml";
   std::string spec, sample, test;  // --virtual-test
   std::vector<arlequin::Override> overrides;  // --set key=value, on the case
@@ -79,6 +85,7 @@ Options parse(int argc, char** argv) {
     if (arg == "--steps") o.steps = std::stol(value());
     else if (arg == "--repeat") o.repeat = std::max(1, std::stoi(value()));
     else if (arg == "--profile") o.profile = true;
+    else if (arg == "--kernel") o.kernel = true;
     else if (arg == "--virtual-test") o.spec = value();
     else if (arg == "--sample") o.sample = value();
     else if (arg == "--test") o.test = value();
@@ -158,6 +165,56 @@ Timing run_block(const Options& o, int threads, arlequin::StepProfile* profile, 
   return {run, bonds * o.steps};
 }
 
+// --kernel: each beam set's block kernel and force pass on one thread, ns per block of bonds.
+void time_beam_kernel(const Options& o) {
+#ifdef _OPENMP
+  omp_set_num_threads(1);
+#endif
+  using arlequin::dem::BeamBondSet;
+  arlequin::app::SceneOptions options;
+  options.overrides = o.overrides;
+  arlequin::app::Scene scene = arlequin::app::build_scene(o.case_file, options);
+  // Some steps first, so that the DEs have moved and turned off their reference.
+  for (long s = 0; s < std::min(o.steps, 200L); ++s) scene.dem.step(scene.dt);
+  auto& particles = scene.dem.particles;
+  constexpr std::size_t block = BeamBondSet::block, cached = 8;  // blocks in the cached run
+  bool timed = false;
+  for (const auto& set : scene.dem.bond_sets()) {
+    const auto* beams = dynamic_cast<const BeamBondSet*>(set.get());
+    if (!beams || beams->size() < cached * block) continue;
+    const std::size_t blocks = beams->size() / block, passes = std::max<std::size_t>(1, 2000000 / beams->size());
+    BeamBondSet::ActionsBlock out;
+    double sink = 0.0;  // read from every block, so that no evaluation can be dropped
+    const auto fastest = [](auto&& run) {
+      double best = 1e300;
+      for (int r = 0; r < 5; ++r) {
+        const auto t0 = Clock::now();
+        run();
+        best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
+      }
+      return best;
+    };
+    const double all = fastest([&] {
+      for (std::size_t pass = 0; pass < passes; ++pass)
+        for (std::size_t k = 0; k < blocks; ++k) beams->actions(k * block, block, particles, out), sink += out.force_on_j[0][0];
+    });
+    const double one = fastest([&] {
+      for (std::size_t pass = 0; pass < passes; ++pass)
+        for (std::size_t k = 0; k < blocks; ++k) beams->actions(k % cached * block, block, particles, out), sink += out.force_on_j[0][0];
+    });
+    const double pass = fastest([&] {
+      for (std::size_t k = 0; k < passes; ++k) beams->accumulate_forces(particles, {});
+    });
+    const double evaluated = double(passes) * double(blocks);
+    std::printf("beam kernel, set '%s' (%zu bonds, blocks of %zu): over the set %.1f ns/block, over %zu blocks in cache "
+                "%.1f ns/block, force pass %.1f ns/block (%.1f ns/bond)%s\n",
+                set->name.c_str(), beams->size(), block, 1e9 * all / evaluated, cached, 1e9 * one / evaluated,
+                1e9 * pass / evaluated, 1e9 * pass / (evaluated * double(block)), sink == 0.125 ? " " : "");
+    timed = true;
+  }
+  if (!timed) std::printf("beam kernel: %s has no beam set of %zu bonds or more\n", o.case_file.c_str(), cached * block);
+}
+
 // A virtual test to its end; the time loop's wall time is the profile's (always attached).
 Timing run_virtual_test(const Options& o, int threads, arlequin::StepProfile& profile) {
   const auto out = std::filesystem::temp_directory_path() / "bench_bonded_block_virtual_test";
@@ -188,6 +245,10 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) try {
   const Options o = parse(argc, argv);
+  if (o.kernel) {
+    time_beam_kernel(o);
+    return 0;
+  }
   const bool virtual_test = !o.spec.empty();
   if (virtual_test)
     std::printf("virtual-test benchmark: %s, sample %s, test %s\n", o.spec.c_str(), o.sample.c_str(), o.test.c_str());

@@ -51,6 +51,7 @@ inline LaneVec rotate(const LaneQuat& q, const LaneVec& a) {
   const LaneVec t = 2.0 * cross(q.v, a);
   return a + q.w * t + cross(q.v, t);
 }
+using LaneMask = decltype(Lanes{} < Lanes{});
 inline Lanes lane_sqrt(Lanes x) {
 #if defined(__AVX512F__)
   static_assert(lanes == 8);
@@ -59,6 +60,42 @@ inline Lanes lane_sqrt(Lanes x) {
   Lanes r;
   for (std::size_t l = 0; l < lanes; ++l) r[l] = std::sqrt(x[l]);
   return r;
+#endif
+}
+// 1 / x and 1 / sqrt(x) without a division. A division's result comes some 20 cycles after its
+// operand, and the kernel's chain (length, axis, the two end rotations, the twist) waited on
+// four of them in turn; the AVX-512 estimates (relative error below 2^-14) take a few cycles,
+// and two Newton steps, r (2 - x r) and y (3/2 - x y^2 / 2), each square the error, to within
+// rounding: a relative error below 3e-16 (about an ulp) over all normal x. A zero x gives NaN
+// where the division gave infinity: a cosine c <= 0 is a lane the kernel takes again beyond its
+// series, and a zero length gave NaN before too (the axis, 0 times infinity).
+inline Lanes reciprocal(Lanes x) {
+#if defined(__AVX512F__)
+  Lanes r = _mm512_rcp14_pd(x);
+  for (int step = 0; step < 2; ++step) r = r + r * (1.0 - x * r);
+  return r;
+#else
+  return 1.0 / x;
+#endif
+}
+inline Lanes inverse_sqrt(Lanes x) {
+#if defined(__AVX512F__)
+  Lanes y = _mm512_rsqrt14_pd(x);
+  const Lanes half_x = 0.5 * x;
+  for (int step = 0; step < 2; ++step) y = y * (1.5 - half_x * (y * y));
+  return y;
+#else
+  return 1.0 / lane_sqrt(x);
+#endif
+}
+// Whether every lane of m is set: the test that lets a block skip the rare lanes' loops.
+inline bool every_lane(LaneMask m) {
+#if defined(__AVX512F__)
+  return _mm512_test_epi64_mask(__m512i(m), __m512i(m)) == 0xff;
+#else
+  for (std::size_t l = 0; l < lanes; ++l)
+    if (!m[l]) return false;
+  return true;
 #endif
 }
 
@@ -82,6 +119,15 @@ inline LaneQuat transpose(const Quad (&q)[lanes]) {
            __builtin_shufflevector(yz01, yz23, 1, 3, 5, 7, 9, 11, 13, 15)}};
 }
 
+// A position (x, y, z, 0) as one vector: a masked load, which reads nothing past z.
+inline Quad load_position(const Vec3& x) {
+#if defined(__AVX512F__)
+  return _mm256_maskz_loadu_pd(0x7, &x.x);
+#else
+  return Quad{x.x, x.y, x.z, 0.0};
+#endif
+}
+
 // The series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
 // (2.9 degrees, where bonds live) it is exact to 5e-12 relative and costs a tenth of libm's
 // atan2, which otherwise dominates the bond loop (and has no vector form here).
@@ -90,9 +136,10 @@ inline Lanes atan_over_x(Lanes x2) { return 1.0 - x2 * (1.0 / 3.0 - x2 * (1.0 / 
 
 // atan2(s, c), the twist angle.
 inline Lanes bond_angle(Lanes s, Lanes c) {
-  const Lanes x = s / c;
+  const Lanes x = s * reciprocal(c);
   Lanes angle = x * atan_over_x(x * x);
   const auto series = (c > 0.0) & ((s < 0.0 ? -s : s) < series_limit * c);
+  if (every_lane(series)) return angle;
   for (std::size_t l = 0; l < lanes; ++l)
     if (!series[l]) angle[l] = std::atan2(s[l], c[l]);  // a lane beyond the series (rare)
   return angle;
@@ -101,12 +148,13 @@ inline Lanes bond_angle(Lanes s, Lanes c) {
 // Rotation vector turning unit vector a onto unit vector b (exact for any angle, no loss near
 // 0 or pi/2); zero where a and b are parallel to the last bit. With s = |a x b| and c = a.b it
 // is (a x b) atan2(s, c) / s; in the series' range atan(s/c)/s = atan_over_x(s^2/c^2) / c, so
-// neither s nor s/c is needed: one division, no square root.
+// neither s nor s/c is needed: one reciprocal, no square root.
 inline LaneVec rotation_between(const LaneVec& a, const LaneVec& b) {
   const LaneVec axis = cross(a, b);
-  const Lanes s2 = dot(axis, axis), c = dot(a, b), inverse_c = 1.0 / c;
+  const Lanes s2 = dot(axis, axis), c = dot(a, b), inverse_c = reciprocal(c);
   Lanes scale = inverse_c * atan_over_x(s2 * inverse_c * inverse_c);
   const auto series = (c > 0.0) & (s2 < (series_limit * series_limit) * (c * c));
+  if (every_lane(series)) return axis * scale;
   for (std::size_t l = 0; l < lanes; ++l)
     if (!series[l]) {  // beyond the series (rare)
       const double s = std::sqrt(s2[l]);
@@ -187,21 +235,28 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
                                             ActionsBlock& out) const {
   assert(count >= 1 && count <= lanes);
   // Lane l holds bond first + l; lanes past count repeat the last bond (out holds it there
-  // again). The DEs' positions are gathered lane by lane, their orientations loaded whole and
-  // transposed; the bonds' own data, stored per component, are consecutive in a full block
-  // and load as whole vectors.
+  // again). The DEs' positions (as x, y, z, 0) and orientations are loaded whole, one vector a
+  // DE, and transposed; the bonds' own data, stored per component, are consecutive in a full
+  // block and load as whole vectors.
   const auto bond_of_lane = [first, count](std::size_t l) { return first + std::min(l, count - 1); };
-  LaneVec d;
-  Quad qa[lanes], qb[lanes];
-  const auto put = [](LaneVec& v, std::size_t l, const Vec3& x) { v.x[l] = x.x, v.y[l] = x.y, v.z[l] = x.z; };
+  std::uint32_t first_de[lanes], second_de[lanes];
+  if (count == lanes) {
+    std::memcpy(first_de, first_.data() + first, sizeof first_de);
+    std::memcpy(second_de, second_.data() + first, sizeof second_de);
+  } else
+    for (std::size_t l = 0; l < lanes; ++l) first_de[l] = first_[bond_of_lane(l)], second_de[l] = second_[bond_of_lane(l)];
+  // Raw pointers: the stores to the local arrays below cannot move them, and the compiler then
+  // keeps them in registers.
+  const Vec3* position = p.position.data();
+  const Quat* orientation = p.orientation.data();
+  Quad qa[lanes], qb[lanes], da[lanes];
   for (std::size_t l = 0; l < lanes; ++l) {
-    const std::size_t b = bond_of_lane(l);
-    const std::uint32_t i = first_[b], j = second_[b];
-    put(d, l, p.position[j] - p.position[i]);
-    std::memcpy(&qa[l], &p.orientation[i], sizeof(Quad));
-    std::memcpy(&qb[l], &p.orientation[j], sizeof(Quad));
+    da[l] = load_position(position[second_de[l]]) - load_position(position[first_de[l]]);
+    std::memcpy(&qa[l], &orientation[first_de[l]], sizeof(Quad));
+    std::memcpy(&qb[l], &orientation[second_de[l]], sizeof(Quad));
   }
-  const LaneQuat qi = transpose(qa), qj = transpose(qb);
+  const LaneQuat qi = transpose(qa), qj = transpose(qb), dq = transpose(da);
+  const LaneVec d{dq.w, dq.v.x, dq.v.y};
   const auto load = [&](const std::vector<double>& data) {
     Lanes v;
     if (count == lanes) std::memcpy(&v, data.data() + first, sizeof v);
@@ -212,8 +267,9 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
   const LaneVec direction{load(direction_[0]), load(direction_[1]), load(direction_[2])};
   const LaneVec normal{load(normal_[0]), load(normal_[1]), load(normal_[2])};
   const Lanes rest_length = load(rest_length_), axial = load(axial_), bending = load(bending_), torsion = load(torsion_);
-  const Lanes length = lane_sqrt(dot(d, d));
-  const LaneVec axis = d * (1.0 / length);
+  // The length and its inverse from the squared length side by side, not one after the other.
+  const Lanes length2 = dot(d, d), length = lane_sqrt(length2), inverse_length = inverse_sqrt(length2);
+  const LaneVec axis = d * inverse_length;
   const LaneVec theta_a = rotation_between(axis, rotate(qi, direction));
   const LaneVec theta_b = rotation_between(axis, rotate(qj, direction));
   // Twist about the axis between the two body-fixed copies of p0; the components of p
@@ -225,7 +281,7 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
   const Lanes torsion_moment = torsion * twist;
   const LaneVec torque_on_i = -bending * (2.0 * theta_a + theta_b) + torsion_moment * axis;
   const LaneVec torque_on_j = -bending * (theta_a + 2.0 * theta_b) - torsion_moment * axis;
-  const LaneVec force_on_j = -axial_force * axis + cross(axis, torque_on_i + torque_on_j) * (1.0 / length);
+  const LaneVec force_on_j = -axial_force * axis + cross(axis, torque_on_i + torque_on_j) * inverse_length;
   const auto store = [](ActionsBlock::Lane& to, const Lanes& from) { std::memcpy(to, &from, sizeof from); };
   const auto store_vec = [&store](ActionsBlock::Lane* to, const LaneVec& from) {
     store(to[0], from.x), store(to[1], from.y), store(to[2], from.z);
