@@ -46,10 +46,15 @@ inline Lanes dot(const LaneVec& a, const LaneVec& b) { return a.x * b.x + a.y * 
 inline LaneVec cross(const LaneVec& a, const LaneVec& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-// R(q) a = a + 2w (v x a) + 2 v x (v x a), as common/quat.hpp's rotate.
+// R(q) a = a + 2w (v x a) + 2 v x (v x a), as common/quat.hpp's rotate: with t = (2 v) x a (2 v
+// exact, shared by the rotations with one q), each component a + w t + v x t as three fused
+// multiply-adds, not a product, a cross product and two sums.
 inline LaneVec rotate(const LaneQuat& q, const LaneVec& a) {
-  const LaneVec t = 2.0 * cross(q.v, a);
-  return a + q.w * t + cross(q.v, t);
+  const LaneVec& v = q.v;
+  const LaneVec t = cross(v + v, a);
+  return {a.x + q.w * t.x + v.y * t.z - v.z * t.y,  //
+          a.y + q.w * t.y + v.z * t.x - v.x * t.z,  //
+          a.z + q.w * t.z + v.x * t.y - v.y * t.x};
 }
 using LaneMask = decltype(Lanes{} < Lanes{});
 inline Lanes lane_sqrt(Lanes x) {
