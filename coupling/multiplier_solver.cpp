@@ -19,7 +19,8 @@ namespace {
 template <int width>
 void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, double* x,
                        std::vector<double>& scratch) {
-  const auto& L = f.matrixL().nestedExpression();  // strictly lower part used: L's diagonal is 1
+  // L by columns, each holding only its rows below the diagonal (an LDL^T stores no unit diagonal)
+  const auto& L = f.matrixL().nestedExpression();
   const Eigen::Index n = L.cols();
   const int* perm = f.permutationP().indices().data();
   const int* outer = L.outerIndexPtr();
@@ -31,14 +32,22 @@ void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>&
     for (int c = 0; c < width; ++c) y[perm[i] * width + c] = x[i * width + c];
   for (Eigen::Index j = 0; j < n; ++j)  // L y' = y
     for (int p = outer[j]; p < outer[j + 1]; ++p)
-      if (inner[p] > j)
-        for (int c = 0; c < width; ++c) y[inner[p] * width + c] -= value[p] * y[j * width + c];
+      for (int c = 0; c < width; ++c) y[inner[p] * width + c] -= value[p] * y[j * width + c];
   for (Eigen::Index j = 0; j < n; ++j)
     for (int c = 0; c < width; ++c) y[j * width + c] /= D[j];
-  for (Eigen::Index j = n - 1; j >= 0; --j)  // L^T y'' = y'
-    for (int p = outer[j]; p < outer[j + 1]; ++p)
-      if (inner[p] > j)
-        for (int c = 0; c < width; ++c) y[j * width + c] -= value[p] * y[inner[p] * width + c];
+  // L^T y'' = y': a dot product per column, in four partial sums (one sum would wait on each
+  // add in turn: the solve's critical path).
+  constexpr int sums = 4;
+  for (Eigen::Index j = n - 1; j >= 0; --j) {
+    double sum[sums][width] = {};
+    int p = outer[j];
+    for (; p + sums <= outer[j + 1]; p += sums)
+      for (int u = 0; u < sums; ++u)
+        for (int c = 0; c < width; ++c) sum[u][c] += value[p + u] * y[inner[p + u] * width + c];
+    for (; p < outer[j + 1]; ++p)
+      for (int c = 0; c < width; ++c) sum[0][c] += value[p] * y[inner[p] * width + c];
+    for (int c = 0; c < width; ++c) y[j * width + c] -= (sum[0][c] + sum[1][c]) + (sum[2][c] + sum[3][c]);
+  }
   for (Eigen::Index i = 0; i < n; ++i)
     for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i] * width + c];
 }
@@ -68,71 +77,109 @@ bool is_diagonal(const SparseMatrix& G) {
 
 }  // namespace
 
-std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc,
-                                                                            int component) const {
+std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() const {
   const CouplingOperators& ops = *ops_;
   if (!ops.settings.fine_l2() || !is_diagonal(ops.Gd)) return nullptr;
   const int rows = ops.rows();
   auto a = std::make_unique<LowRank>();
   a->inv_D.resize(rows);
+  a->tied.resize(rows, 3);
   const Eigen::VectorXd g = ops.Gd.diagonal();
   for (int r = 0; r < rows; ++r) {
-    const double d = g[r] * g[r] * md[r];
-    if (!(d > 0.0)) return nullptr;  // a driven DE: D is singular
+    const double d = g[r] * g[r] * inv_d_(r, 0);  // a DE's inverse mass is the same in x, y and z
+    if (!(d > 0.0)) return nullptr;               // a driven DE: D is singular
     a->inv_D[r] = 1.0 / d;
+    for (int c = 0; c < 3; ++c) a->tied(r, c) = is_tied(r, c) ? 1.0 : 0.0;
   }
-  // The continuum dofs G_c reaches that can move, renumbered 0..k-1.
-  std::vector<int> reduced(static_cast<std::size_t>(ops.Gc.cols()), -1);
+  // U's columns: the continuum nodes G_c reaches from a row tied in a component the node can move in.
+  std::vector<int> column(static_cast<std::size_t>(ops.Gc.cols()), -1);
   int k = 0;
+  for (int r = 0; r < rows; ++r)
+    for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        if (is_tied(r, c) && inv_c_(it.col(), c) != 0.0 && column[static_cast<std::size_t>(it.col())] < 0) {
+          column[static_cast<std::size_t>(it.col())] = k++;
+          a->node.push_back(it.col());
+        }
+  a->movable.resize(k, 3);
+  for (int j = 0; j < k; ++j)
+    for (int c = 0; c < 3; ++c) a->movable(j, c) = inv_c_(a->node[static_cast<std::size_t>(j)], c) != 0.0 ? 1.0 : 0.0;
   std::vector<Eigen::Triplet<double>> t;
-  std::vector<double> masses;
-  for (int r = 0; r < rows; ++r) {
-    if (!is_tied(r, component)) continue;  // a free row's U row is empty: its multiplier stays 0
-    for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it) {
-      const auto j = static_cast<std::size_t>(it.col());
-      if (mc[it.col()] == 0.0) continue;
-      if (reduced[j] < 0) {
-        reduced[j] = k++;
-        masses.push_back(1.0 / mc[it.col()]);
-      }
-      t.emplace_back(r, reduced[j], it.value());
-    }
-  }
+  for (int r = 0; r < rows; ++r)
+    for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it)
+      if (const int j = column[static_cast<std::size_t>(it.col())]; j >= 0) t.emplace_back(r, j, it.value());
   a->U.resize(rows, k);
   a->U.setFromTriplets(t.begin(), t.end());
   a->Ut = RowMajorMatrix(a->U.transpose());
-  Eigen::SparseMatrix<double> K = Eigen::SparseMatrix<double>(a->Ut) * a->inv_D.asDiagonal() * a->U;
-  for (int j = 0; j < k; ++j) K.coeffRef(j, j) += masses[static_cast<std::size_t>(j)];
-  a->K = std::make_unique<Factor>();
-  a->K->compute(K);
-  if (a->K->info() != Eigen::Success || !(a->K->vectorD().minCoeff() > 0.0)) return nullptr;
-  a->K_diagonal = a->K->vectorD();
-  // The set-up check: A y = r to 1e-10 for y solved from a fixed r (A applied matrix-free).
-  Eigen::VectorXd r(rows), y(rows);
-  for (int i = 0; i < rows; ++i) r[i] = 1.0 + 0.5 * std::sin(1.0 + i);
-  y = r;
-  solve_low_rank<1>(*a, y.data());
-  Eigen::VectorXd Ay = y.cwiseQuotient(a->inv_D);
-  const Eigen::VectorXd Uty = a->Ut * y;
-  Eigen::VectorXd CUty(k);
-  for (int j = 0; j < k; ++j) CUty[j] = Uty[j] / masses[static_cast<std::size_t>(j)];
-  Ay += a->U * CUty;
+  // Each system's K over all of U's columns: U_c = T_c U H_c (its tied rows, its movable
+  // columns); a column the component holds gets a unit pivot and, its right-hand side masked
+  // to 0, a zero solution.
+  for (int c = 0; c < 3; ++c) {
+    if (factor_of_[c] < static_cast<int>(a->K.size())) continue;  // served by an earlier component's
+    std::vector<Eigen::Triplet<double>> tc;
+    for (const auto& e : t)
+      if (a->tied(e.row(), c) != 0.0 && a->movable(e.col(), c) != 0.0) tc.push_back(e);
+    RowMajorMatrix Uc(rows, k);
+    Uc.setFromTriplets(tc.begin(), tc.end());
+    Eigen::SparseMatrix<double> K = Eigen::SparseMatrix<double>(Uc.transpose()) * a->inv_D.asDiagonal() * Uc;
+    for (int j = 0; j < k; ++j)
+      K.coeffRef(j, j) += a->movable(j, c) != 0.0 ? 1.0 / inv_c_(a->node[static_cast<std::size_t>(j)], c) : 1.0;
+    auto f = std::make_unique<Factor>();
+    f->compute(K);
+    if (f->info() != Eigen::Success || !(f->vectorD().minCoeff() > 0.0)) return nullptr;
+    a->K_diagonal.push_back(f->vectorD());
+    a->K.push_back(std::move(f));
+  }
+  // The set-up check: A y = r to 1e-10 for y solved from a fixed r (A applied matrix-free,
+  // D y + T U H C H U^T y per component).
+  Matrix3 r(rows, 3), y;
+  for (int i = 0; i < rows; ++i)
+    for (int c = 0; c < 3; ++c) r(i, c) = a->tied(i, c) * (1.0 + 0.5 * std::sin(1.0 + i + 7.0 * c));
+  solve_low_rank(*a, r, y, nullptr);
+  Matrix3 q = a->Ut * y, Ay(rows, 3);
+  for (int j = 0; j < k; ++j)
+    for (int c = 0; c < 3; ++c) q(j, c) = a->movable(j, c) != 0.0 ? q(j, c) * inv_c_(a->node[static_cast<std::size_t>(j)], c) : 0.0;
+  Ay = a->U * q;
+  for (int i = 0; i < rows; ++i)
+    for (int c = 0; c < 3; ++c) Ay(i, c) = y(i, c) / a->inv_D[i] + a->tied(i, c) * Ay(i, c);
   if (!((Ay - r).norm() <= 1e-10 * r.norm())) return nullptr;
   return a;
 }
 
-template <int width>
-void MultiplierSolver::solve_low_rank(const LowRank& a, double* x) const {
-  const Eigen::Index rows = a.U.rows();
-  for (Eigen::Index r = 0; r < rows; ++r)  // y = D^-1 r
-    for (int c = 0; c < width; ++c) x[r * width + c] *= a.inv_D[r];
-  reduced_.resize(static_cast<std::size_t>(a.U.cols() * width));
-  multiply<width>(a.Ut, x, width, reduced_.data());  // U^T y
-  solve_with_factor<width>(*a.K, a.K_diagonal, reduced_.data(), reduced_scratch_);
-  solution_.resize(static_cast<std::size_t>(rows * width));
-  multiply<width>(a.U, reduced_.data(), width, solution_.data());  // U K^-1 U^T y
-  for (Eigen::Index r = 0; r < rows; ++r)
-    for (int c = 0; c < width; ++c) x[r * width + c] -= a.inv_D[r] * solution_[static_cast<std::size_t>(r * width + c)];
+// The components each system serves, in order (served[0..width)), and their count.
+std::pair<std::array<int, 3>, int> MultiplierSolver::served_by(int k) const {
+  std::array<int, 3> served{};
+  int width = 0;
+  for (int c = 0; c < 3; ++c)
+    if (factor_of_[c] == k) served[static_cast<std::size_t>(width++)] = c;
+  return {served, width};
+}
+
+void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const {
+  const Eigen::Index rows = rhs.rows(), k = a.U.cols();
+  y_.resize(rows, 3);
+  for (Eigen::Index r = 0; r < rows; ++r)  // y = D^-1 rhs, 0 in the free components
+    for (int c = 0; c < 3; ++c) y_(r, c) = a.tied(r, c) * (a.inv_D[r] * rhs(r, c));
+  w_.resize(k, 3);
+  multiply<3>(a.Ut, y_.data(), 3, w_.data());  // U^T y, then w = K^-1 U^T y system by system
+  w_.array() *= a.movable.array();
+  for (int s = 0; s < static_cast<int>(a.K.size()); ++s) {
+    const auto [served, width] = served_by(s);
+    block_.resize(static_cast<std::size_t>(k * width));
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (int m = 0; m < width; ++m) block_[static_cast<std::size_t>(j * width + m)] = w_(j, served[static_cast<std::size_t>(m)]);
+    if (width == 3) solve_with_factor<3>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
+    else if (width == 2) solve_with_factor<2>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
+    else solve_with_factor<1>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
+    for (Eigen::Index j = 0; j < k; ++j)
+      for (int m = 0; m < width; ++m) w_(j, served[static_cast<std::size_t>(m)]) = block_[static_cast<std::size_t>(j * width + m)];
+  }
+  lambda.resize(rows, 3);
+  multiply<3>(a.U, w_.data(), 3, lambda.data());  // U w
+  for (Eigen::Index r = 0; r < rows; ++r)  // lambda = y - D^-1 U w
+    for (int c = 0; c < 3; ++c) lambda(r, c) = a.tied(r, c) * (y_(r, c) - a.inv_D[r] * lambda(r, c));
+  if (dc)  // M_c^-1 G_c^T lambda = w on U's columns (header)
+    for (Eigen::Index j = 0; j < k; ++j) dc->row(a.node[static_cast<std::size_t>(j)]) = w_.row(j);
 }
 
 int MultiplierSolver::system_of_earlier_component(int c) const {
@@ -152,29 +199,21 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
   for (int p = 0; p < np; ++p) inv_d_.row(p).setConstant(inv_mass_d[p]);
   inv_c_ = Eigen::Map<const Matrix3>(inv_mass_c.data(), nn, 3);
 
-  // The low-rank form when every distinct component has it; else the general factor.
+  // The systems: a component shares an earlier one's when its masses and ties are the same.
+  for (int c = 0; c < 3; ++c) {
+    const int same = system_of_earlier_component(c);
+    factor_of_[c] = same >= 0 ? same : systems_++;
+  }
+  // The low-rank form when it applies; else the general factor.
   if (!petsc) {
-    for (int c = 0; c < 3; ++c) {
-      if (const int same = system_of_earlier_component(c); same >= 0) {
-        factor_of_[c] = same;
-        continue;
-      }
-      auto a = low_rank_form(inv_d_.col(c), inv_c_.col(c), c);
-      if (!a) {
-        low_rank_.clear();
-        break;
-      }
-      factor_of_[c] = static_cast<int>(low_rank_.size());
-      nonzeros_ = a->U.nonZeros();
-      low_rank_.push_back(std::move(a));
+    low_rank_ = low_rank_form();
+    if (low_rank_) {
+      nonzeros_ = low_rank_->U.nonZeros();
+      return;
     }
-    if (!low_rank_.empty()) return;
   }
   for (int c = 0; c < 3; ++c) {
-    if (const int same = system_of_earlier_component(c); same >= 0) {
-      factor_of_[c] = same;
-      continue;
-    }
+    if (system_of_earlier_component(c) >= 0) continue;
     const Eigen::VectorXd md = inv_d_.col(c), mc = inv_c_.col(c);
     Eigen::VectorXd tie = Eigen::VectorXd::Ones(ops.rows());  // free rows empty: their multipliers 0 (below)
     for (int r = 0; r < ops.rows(); ++r) tie[r] = is_tied(r, c) ? 1.0 : 0.0;
@@ -213,7 +252,6 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
           << "of the overlap needs enough DEs to fix its nodes (use a larger overlap, a finer DEM, or mediator: fine)";
       throw RunError(msg.str());
     }
-    factor_of_[c] = static_cast<int>(scales_.size());
     scales_.push_back(scale);
     if (petsc) {
       petsc_.push_back(std::make_unique<PetscSpdSolver>(Acol, *petsc));
@@ -227,14 +265,12 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
 // Per system, the components it serves solved together (columns of one row-major block): the
 // low-rank form, PETSc's KSP (a column at a time), or our factor of the Jacobi-scaled A,
 // S P^T L D L^T P S lambda = rhs.
-void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
+void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const {
+  if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda, dc);
   lambda.resize(rhs.rows(), 3);
   const Eigen::Index rows = rhs.rows();
-  for (int k = 0; k < systems(); ++k) {
-    std::array<int, 3> served{};
-    int width = 0;
-    for (int c = 0; c < 3; ++c)
-      if (factor_of_[c] == k) served[static_cast<std::size_t>(width++)] = c;
+  for (int k = 0; k < systems_; ++k) {
+    const auto [served, width] = served_by(k);
     if (!petsc_.empty()) {
       // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
       // from another component or step would make the multipliers depend on the run's history,
@@ -249,27 +285,24 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
       continue;
     }
     block_.resize(static_cast<std::size_t>(rows * width));
-    const double* scale = low_rank_.empty() ? scales_[k].data() : nullptr;
+    const double* scale = scales_[k].data();
     for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s)
-        block_[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * (scale ? scale[r] : 1.0);
-    const auto solve_block = [&]<int w>() {
-      if (low_rank_.empty()) solve_with_factor<w>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
-      else solve_low_rank<w>(*low_rank_[k], block_.data());
-    };
-    if (width == 3) solve_block.template operator()<3>();
-    else if (width == 2) solve_block.template operator()<2>();
-    else solve_block.template operator()<1>();
+      for (int s = 0; s < width; ++s) block_[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * scale[r];
+    if (width == 3) solve_with_factor<3>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
+    else if (width == 2) solve_with_factor<2>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
+    else solve_with_factor<1>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
     for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s)
-        lambda(r, served[static_cast<std::size_t>(s)]) = block_[static_cast<std::size_t>(r * width + s)] * (scale ? scale[r] : 1.0);
+      for (int s = 0; s < width; ++s) lambda(r, served[static_cast<std::size_t>(s)]) = block_[static_cast<std::size_t>(r * width + s)] * scale[r];
   }
 }
 
 std::string MultiplierSolver::backend() const {
-  if (!low_rank_.empty())
-    return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_.front()->U.cols()) + " continuum dofs (" +
-           std::to_string(low_rank_.front()->K->matrixL().nestedExpression().nonZeros()) + " non-zeros in its factor)";
+  if (low_rank_) {
+    long largest = 0;
+    for (const auto& K : low_rank_->K) largest = std::max<long>(largest, K->matrixL().nestedExpression().nonZeros());
+    return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_->U.cols()) + " continuum nodes a system (" +
+           std::to_string(largest) + " non-zeros in the largest factor)";
+  }
   return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description();
 }
 
@@ -282,13 +315,16 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
-  solve(rhs_, lambda);
+  dc.resize(GcT_.rows(), 3);
+  if (low_rank_) dc.setZero();  // the nodes outside U's columns
+  solve(rhs_, lambda, &dc);
   dd.resize(GdT_.rows(), 3);
   multiply<3>(GdT_, lambda.data(), 3, dd.data());
   dd.array() *= inv_d_.array();
-  dc.resize(GcT_.rows(), 3);
-  multiply<3>(GcT_, lambda.data(), 3, dc.data());
-  dc.array() *= inv_c_.array();
+  if (!low_rank_) {
+    multiply<3>(GcT_, lambda.data(), 3, dc.data());
+    dc.array() *= inv_c_.array();
+  }
   vd -= dd;
   vc -= dc;
 }

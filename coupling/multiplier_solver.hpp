@@ -31,8 +31,11 @@
 //    thousands of entries for a yarn-dense overlap), is solved exactly by the
 //    Sherman-Morrison-Woodbury identity (docs/references.md#golub2013): A^-1 r = D^-1 r - D^-1 U K^-1 U^T D^-1 r with K = C^-1 + U^T D^-1 U, a
 //    matrix over those continuum nodes only, SPD, factored once (LDL^T). A step then costs
-//    O(non-zeros of N). The subtraction is benign when the continuum's nodes outweigh the DEs
-//    they carry (C small against D^-1's scale: the case of a coupling); it is checked at set-up
+//    O(non-zeros of N): U is stored once for the three components (a component's U keeps its
+//    tied rows and the nodes it can move: masks, not copies) and read once for all three; each
+//    system has its own K. The continuum's correction needs no product with G_c^T: with
+//    w = K^-1 U^T D^-1 r, U^T lambda = U^T D^-1 r - (K - C^-1) w = C^-1 w, so C U^T lambda = w.
+//    The subtraction is benign when the continuum's nodes outweigh the DEs they carry (C small against D^-1's scale: the case of a coupling); it is checked at set-up
 //    on a residual of A, matrix-free, and the general LDL^T above is used when the check fails
 //    (or with PETSc, or with H1 coupling, whose S is not diagonal). backend() says which.
 //  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
@@ -48,6 +51,7 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -66,15 +70,15 @@ class MultiplierSolver {
                    const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc);
 
   // A lambda = rhs per component (rhs, lambda: rows x 3).
-  void solve(const Matrix3& rhs, Matrix3& lambda) const;
+  void solve(const Matrix3& rhs, Matrix3& lambda) const { solve(rhs, lambda, nullptr); }
   // out = G_d vd + G_c vc (rows x 3), 0 in the components a row leaves free.
   void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
-  // Distinct systems (one per distinct column of inverse masses; the others reuse one).
-  int systems() const { return static_cast<int>(low_rank_.empty() ? scales_.size() : low_rank_.size()); }
-  // "LDL^T", "diagonal + low rank (Woodbury), LDL^T of <k> continuum dofs" or "PETSc <ksp> + <pc>".
+  // Distinct systems (one per distinct column of inverse masses and ties; the others reuse one).
+  int systems() const { return systems_; }
+  // "LDL^T", "diagonal + low rank (Woodbury), LDL^T of <k> continuum nodes a system ..." or "PETSc <ksp> + <pc>".
   std::string backend() const;
   int rows() const { return ops_->rows(); }
   // Non-zeros of what a solve reads: the scaled A (its factor fills in more), or U for the
@@ -87,36 +91,43 @@ class MultiplierSolver {
   using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct LowRank {
     Eigen::VectorXd inv_D;            // per row
-    RowMajorMatrix U, Ut;             // rows x reached dofs of the component, and its transpose
-    std::unique_ptr<Factor> K;
-    Eigen::VectorXd K_diagonal;
+    Matrix3 tied;                     // per row and component: 1 held, 0 free (CouplingOperators::tied)
+    RowMajorMatrix U, Ut;             // rows x the nodes G_c reaches that can move (all components'), its transpose
+    std::vector<int> node;            // the continuum node of each of U's columns
+    Matrix3 movable;                  // per column and component: 1 where the node can move, 0 where held
+    std::vector<std::unique_ptr<Factor>> K;  // per system, over all of U's columns
+    std::vector<Eigen::VectorXd> K_diagonal;
   };
-  // The low-rank form of A for inverse masses (md, mc), or nullptr when it does not apply or its
-  // set-up residual check fails.
-  std::unique_ptr<LowRank> low_rank_form(const Eigen::VectorXd& md, const Eigen::VectorXd& mc, int component) const;
+  // The low-rank form of A, or nullptr when it does not apply or its set-up residual check fails.
+  std::unique_ptr<LowRank> low_rank_form() const;
   // Whether the constraint holds row r's component c (CouplingOperators::tied).
   bool is_tied(int r, int c) const { return ops_->tied.size() == 0 || ops_->tied(r, c) != 0.0; }
-  // x = A^-1 x for `width` components (rows x width, row-major).
-  template <int width>
-  void solve_low_rank(const LowRank& a, double* x) const;
+  // lambda = A^-1 rhs, every system at once: the products with U and U^T read U once for the
+  // three components; with `dc`, dc = M_c^-1 G_c^T lambda on U's columns (the rest untouched).
+  void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
+  // solve() that, with the low-rank form and `dc`, also sets dc as solve_low_rank does.
+  void solve(const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
+  // The components system k serves (the first `width` entries) and their number.
+  std::pair<std::array<int, 3>, int> served_by(int k) const;
   // The system of an earlier component with the same continuum inverse masses and ties (the DEs'
   // masses are the same for all three components), or -1.
   int system_of_earlier_component(int c) const;
 
   const CouplingOperators* ops_;
   RowMajorMatrix GdT_, GcT_;                   // the transposes, for row-wise products
-  std::vector<std::unique_ptr<LowRank>> low_rank_;  // one per system, or empty
+  std::unique_ptr<LowRank> low_rank_;          // the low-rank form, or null
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
   std::vector<std::unique_ptr<Factor>> factors_;  // our LDL^T, or
   std::vector<std::unique_ptr<PetscSpdSolver>> petsc_;  // PETSc's solve
   std::vector<Eigen::VectorXd> diagonals_;     // D of each factor
   std::vector<Eigen::VectorXd> scales_;        // Jacobi scaling diag(A)^-1/2 of each factor
-  std::array<int, 3> factor_of_{0, 0, 0};      // component -> factor
+  std::array<int, 3> factor_of_{0, 0, 0};      // component -> system
+  int systems_ = 0;
   long nonzeros_ = 0;
   mutable Matrix3 rhs_;                        // scratch: the residual to project
   mutable Eigen::VectorXd column_;              // scratch: one component (PETSc)
   mutable std::vector<double> block_, block_scratch_, solution_;  // scratch: a system's components
-  mutable std::vector<double> reduced_, reduced_scratch_;  // scratch: the low-rank form's K solve
+  mutable Matrix3 y_, w_;                      // scratch: the low-rank form's D^-1 rhs and K^-1 U^T y
 };
 
 }  // namespace arlequin::coupling

@@ -130,6 +130,8 @@ void DemModel::finalize() {
     for (const auto& set : bond_sets_) set->add_frequency_bounds(particles, bond_frequency_bound_, rot);
     inv_mass_max_ = 0.0;
     for (std::size_t i = 0; i < n; ++i) inv_mass_max_ = std::max(inv_mass_max_, contact_inv_mass(i));
+    contact_bound_each_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) contact_bound_each_[i] = contact_frequency_bound(i, 1);
     touching_.assign(n, 0);
   }
   if (rdef_) rdef_->prepare(particles, group_members_);
@@ -555,33 +557,62 @@ void DemModel::check_finite() const {
   const ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
   const PhaseTimer timer(profile_, phase_.finite, particle_loops_threaded());
-  // Chunks of DEs on the threads, split as the kicks, each finding its non-finite velocities and,
-  // with contact, its fastest and most crowded DE (the first of equals); the chunks are then taken
-  // in order with the same strict comparisons, so the DEs named are the serial pass's.
+  // Chunks of DEs on the threads, split as the kicks, each a vectorised pass that only finds
+  // whether a velocity is not finite (x - x is 0 for a finite x, NaN otherwise; a sum of them is
+  // NaN if any is) and, with contact, the largest |v|^2 / R^2 and frequency bound: maxima and
+  // that test do not depend on the order of the terms. Only when the step fails a check does
+  // diagnose() take the DEs again, in order, to name them.
+  const Vec3* v = p.velocity.data();
+  const Vec3* w = p.angular_velocity.data();
+  const double* radius = p.radius.data();
+  const std::uint32_t* touching = touching_.data();
+  const double* bond_bound = bond_frequency_bound_.data();
+  const double* contact_bound = contact_bound_each_.data();
+  const bool contact = contact_ != nullptr;
   const long chunks = scan_fixed_chunks(n, parallel_threshold, finite_chunks_, [&](long begin, long end) {
-    FiniteScan scan;
-    for (long k = begin; k < end; ++k) {
-      const auto i = static_cast<std::size_t>(k);
-      if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
-        if (scan.bad++ == 0) scan.first = i;
+    double probe = 0.0, reach2 = 0.0, omega2 = 0.0;
+    if (contact) {
+#pragma omp simd reduction(+ : probe) reduction(max : reach2, omega2)
+      for (long i = begin; i < end; ++i) {
+        probe += ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
+        reach2 = std::max(reach2, norm2(v[i]) / (radius[i] * radius[i]));
+        omega2 = std::max(omega2, touching[i] > 0 ? bond_bound[i] + contact_bound[i] * touching[i] : 0.0);
       }
-      if (!contact_) continue;
-      ContactResolution& worst = scan.worst;
-      if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
-      if (touching_[i] > 0)
-        if (const double row = bond_frequency_bound_[i] + contact_frequency_bound(i, touching_[i]); row > worst.omega2)
-          worst.omega2 = row, worst.crowded = i;
+    } else {
+#pragma omp simd reduction(+ : probe)
+      for (long i = begin; i < end; ++i)
+        probe += ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
     }
-    return scan;
+    return FiniteScan{!(probe == 0.0), reach2, omega2};
   });
-  std::size_t bad = 0, first = 0;
-  ContactResolution worst;  // with contact
+  FiniteScan all;
   for (long c = 0; c < chunks; ++c) {
     const FiniteScan& scan = finite_chunks_[static_cast<std::size_t>(c)];
-    if (scan.bad > 0 && bad == 0) first = scan.first;
-    bad += scan.bad;
-    if (scan.worst.reach > worst.reach) worst.reach = scan.worst.reach, worst.fastest = scan.worst.fastest;
-    if (scan.worst.omega2 > worst.omega2) worst.omega2 = scan.worst.omega2, worst.crowded = scan.worst.crowded;
+    all.bad = all.bad || scan.bad;
+    all.reach2 = std::max(all.reach2, scan.reach2);
+    all.omega2 = std::max(all.omega2, scan.omega2);
+  }
+  if (all.bad || (contact && fails_contact_resolution(std::sqrt(all.reach2) * last_dt_, all.omega2))) diagnose();
+}
+
+bool DemModel::fails_contact_resolution(double reach, double omega2) const {
+  const double dt = last_dt_;
+  return reach > 1.0 || deepest_contact_.deepest > 1.0 || omega2 * dt * dt + 2.0 * damping_ * dt >= 4.0;
+}
+
+void DemModel::diagnose() const {
+  const ParticleSet& p = particles;
+  std::size_t bad = 0, first = 0;
+  ContactResolution worst;  // with contact: the fastest and the most crowded DE, the first of equals
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!is_finite(p.velocity[i]) || !is_finite(p.angular_velocity[i])) {
+      if (bad++ == 0) first = i;
+    }
+    if (!contact_) continue;
+    if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
+    if (touching_[i] > 0)
+      if (const double row = bond_frequency_bound_[i] + contact_bound_each_[i] * touching_[i]; row > worst.omega2)
+        worst.omega2 = row, worst.crowded = i;
   }
   if (bad == 0 && contact_) check_contact_resolution(worst);
   if (bad == 0) return;
@@ -601,8 +632,7 @@ void DemModel::check_contact_resolution(const ContactResolution& worst) const {
   // with its contacts now: stable while omega^2 dt^2 + 2 c dt < 4).
   const ContactPass& c = deepest_contact_;
   const double dt = last_dt_;
-  const bool crowded = worst.omega2 * dt * dt + 2.0 * damping_ * dt >= 4.0;
-  if (worst.reach <= 1.0 && c.deepest <= 1.0 && !crowded) return;
+  if (!fails_contact_resolution(worst.reach, worst.omega2)) return;
   const ParticleSet& p = particles;
   const auto at = [&p](std::size_t i) {
     std::ostringstream where;

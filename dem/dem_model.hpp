@@ -170,6 +170,11 @@ class DemModel {
     std::size_t crowded = 0;      // that DE
   };
   void check_contact_resolution(const ContactResolution& worst) const;
+  // Whether a step whose fastest DE moved `reach` radii and whose largest frequency bound is
+  // omega2 (1/s^2) fails check_contact_resolution.
+  bool fails_contact_resolution(double reach, double omega2) const;
+  // check_finite's slow path, for a step that fails it: the DEs in order, the error naming them.
+  void diagnose() const;
   // Break records under `prefix` of a checkpoint (breaks, held failures); load_events checks each
   // against this scene (StateMismatch naming `what` the bond should be, unless consistent(e)).
   static void save_events(StateArchive& archive, const std::string& prefix, const std::vector<BreakEvent>& events);
@@ -210,6 +215,7 @@ class DemModel {
   std::vector<std::uint32_t> touching_;        // per DE: its touching contacts in the last force pass
   std::vector<double> bond_frequency_bound_;   // per DE: its bonds' translational row of the bound, 1/s^2
   double inv_mass_max_ = 0.0;                  // 1/kg, the largest contact_inv_mass
+  std::vector<double> contact_bound_each_;     // per DE: contact_frequency_bound(i, 1), 1/s^2 (check_finite)
   std::vector<double> contact_weight_;         // per DE: its Arlequin weight alpha (empty: none)
   std::vector<std::vector<std::uint8_t>> held_;  // per set and bond: 1 held, 2 held and its criterion met
   std::vector<BreakEvent> held_failures_;
@@ -227,9 +233,10 @@ class DemModel {
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
   // check_finite's scan of one chunk of DEs.
-  struct FiniteScan {
-    ContactResolution worst;
-    std::size_t bad = 0, first = 0;  // non-finite velocities, the first of them
+  struct FiniteScan {  // check_finite's pass over a chunk of DEs
+    bool bad = false;     // a non-finite velocity
+    double reach2 = 0.0;  // the largest |v|^2 / R^2, 1/s^2
+    double omega2 = 0.0;  // the largest frequency bound with the contacts touching now, 1/s^2
   };
   mutable std::vector<FiniteScan> finite_chunks_;  // scratch: check_finite's chunks
   bool energy_record_requested_ = false;  // record_energies_in_next_step()

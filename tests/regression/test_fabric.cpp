@@ -179,14 +179,16 @@ TEST(FabricCoupled, ReducedImpactWithoutBreakageKeepsTheImpactEnergy) {
 }
 
 // The plate's internal force once every 4 steps (reduced.yaml's continuum_substeps, r-RESPA's
-// impulses) against every step, without breakage. The weave's contacts make the run sensitive:
-// the every-step run with a step 0.3 % shorter moves the sphere's velocity by 0.50 m/s and the
-// plate's peak strain energy by 1.35 % (without the ties and the plate's directional inertia,
-// 0.29 m/s and 1.2 %), so the bounds sit above that floor: the velocity within 0.75 m/s of the
-// every-step run's (measured 0.29), the peak strain energy within 3 % (measured -0.08 %), the
-// sub-cycled run's balance within 6e-4 of the impact energy (measured 3.8e-4) and the every-step
-// run's within 2e-4 (measured 1.2e-4). An opening impulse of 0.6 m dt instead of 0.5 leaves 12 %
-// of the strain energy out and the balance 18 times the impact energy.
+// impulses) against every step, without breakage. From about 20 us the weave's contacts make the
+// run chaotic: pairs of runs whose plate E_z differs by 2e-9 to 2 % (16 pairs, two builds whose
+// multiplier solves differ in round-off) put the sphere's velocity 0.12 to 2.15 m/s apart over
+// the whole run and the plate's peak strain energy -2.9 % to +2.6 %, while up to 20 us the
+// sub-cycling's own difference is 0.052 to 0.094 m/s. So the bounds: the velocity within
+// 0.15 m/s of the every-step run's up to 20 us (measured 0.073) and within 3 m/s over the run
+// (measured 1.44), the peak strain energy within 5 % (measured -0.20 %), the sub-cycled run's
+// balance within 6e-4 of the impact energy (measured 4.2e-4) and the every-step run's within
+// 2e-4 (measured 1.0e-4). An opening impulse of 0.6 m dt instead of 0.5 leaves 12 % of the
+// strain energy out and the balance 18 times the impact energy.
 TEST(FabricCoupled, ThePlateForcedEveryFourthStepFollowsTheEveryStepRun) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -197,14 +199,17 @@ TEST(FabricCoupled, ThePlateForcedEveryFourthStepFollowsTheEveryStepRun) {
                                       " --set dem.sample.yarn.failure_strain=0 --set coupling.continuum_substeps=1", out);
   ASSERT_EQ(substeps.size(), every_step.size());
   ASSERT_FALSE(substeps.empty());
-  double velocity = 0.0, peak_4 = 0.0, peak_1 = 0.0;
+  double early = 0.0, velocity = 0.0, peak_4 = 0.0, peak_1 = 0.0;
   for (std::size_t k = 0; k < substeps.size(); ++k) {
-    velocity = std::max(velocity, std::abs(at(substeps[k], "sphere_velocity") - at(every_step[k], "sphere_velocity")));
+    const double difference = std::abs(at(substeps[k], "sphere_velocity") - at(every_step[k], "sphere_velocity"));
+    if (at(substeps[k], "time") <= 20e-6) early = std::max(early, difference);
+    velocity = std::max(velocity, difference);
     peak_4 = std::max(peak_4, at(substeps[k], "C_strain"));
     peak_1 = std::max(peak_1, at(every_step[k], "C_strain"));
   }
-  EXPECT_LT(velocity, 0.75);
-  EXPECT_NEAR(peak_4 / peak_1, 1.0, 0.03);
+  EXPECT_LT(early, 0.15);
+  EXPECT_LT(velocity, 3.0);
+  EXPECT_NEAR(peak_4 / peak_1, 1.0, 0.05);
   EXPECT_LT(worst_balance(substeps), 6e-4 * impact_energy());
   EXPECT_LT(worst_balance(every_step), 2e-4 * impact_energy());
 }

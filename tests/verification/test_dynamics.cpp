@@ -227,12 +227,15 @@ TEST(PenaltyContact, TooFastOrTooSoftStopsTheRun) {
     return model;
   };
   auto fast = pair(1e6, 10 * R);  // not in contact during the step
+  fast->particles.velocity[1] = {-v, 0, 0};
+  fast->particles.velocity[0] = {0.6 * v, 0, 0};  // too fast as well, but the message names the fastest
   EXPECT_LE(fast->critical_time_step(), R / v);
   fast->step(2.5 * R / v);
   try {
     fast->check_finite();
     FAIL() << "a DE moving 2.5 radii per step was not stopped";
   } catch (const RunError& e) {
+    EXPECT_NE(std::string(e.what()).find("DE 1 at"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("moves 2.5 of its radius per step"), std::string::npos) << e.what();
   }
   // m v^2 = 0.033 J, K R^2 = 1e-4 J: the spheres go through each other.
