@@ -265,8 +265,8 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
 // Per system, the components it serves solved together (columns of one row-major block): the
 // low-rank form, PETSc's KSP (a column at a time), or our factor of the Jacobi-scaled A,
 // S P^T L D L^T P S lambda = rhs.
-void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const {
-  if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda, dc);
+void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
+  if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda, nullptr);
   lambda.resize(rhs.rows(), 3);
   const Eigen::Index rows = rhs.rows();
   for (int k = 0; k < systems_; ++k) {
@@ -316,15 +316,17 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
   dc.resize(GcT_.rows(), 3);
-  if (low_rank_) dc.setZero();  // the nodes outside U's columns
-  solve(rhs_, lambda, &dc);
-  dd.resize(GdT_.rows(), 3);
-  multiply<3>(GdT_, lambda.data(), 3, dd.data());
-  dd.array() *= inv_d_.array();
-  if (!low_rank_) {
+  if (low_rank_) {  // the solve leaves M_c^-1 G_c^T lambda on U's columns, 0 on the other nodes
+    dc.setZero();
+    solve_low_rank(*low_rank_, rhs_, lambda, &dc);
+  } else {
+    solve(rhs_, lambda);
     multiply<3>(GcT_, lambda.data(), 3, dc.data());
     dc.array() *= inv_c_.array();
   }
+  dd.resize(GdT_.rows(), 3);
+  multiply<3>(GdT_, lambda.data(), 3, dd.data());
+  dd.array() *= inv_d_.array();
   vd -= dd;
   vc -= dc;
 }

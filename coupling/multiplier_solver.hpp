@@ -35,7 +35,8 @@
 //    tied rows and the nodes it can move: masks, not copies) and read once for all three; each
 //    system has its own K. The continuum's correction needs no product with G_c^T: with
 //    w = K^-1 U^T D^-1 r, U^T lambda = U^T D^-1 r - (K - C^-1) w = C^-1 w, so C U^T lambda = w.
-//    The subtraction is benign when the continuum's nodes outweigh the DEs they carry (C small against D^-1's scale: the case of a coupling); it is checked at set-up
+//    The subtraction is benign when the continuum's nodes outweigh the DEs they carry (C small
+//    against D^-1's scale: the case of a coupling); it is checked at set-up
 //    on a residual of A, matrix-free, and the general LDL^T above is used when the check fails
 //    (or with PETSc, or with H1 coupling, whose S is not diagonal). backend() says which.
 //  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
@@ -70,7 +71,7 @@ class MultiplierSolver {
                    const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc);
 
   // A lambda = rhs per component (rhs, lambda: rows x 3).
-  void solve(const Matrix3& rhs, Matrix3& lambda) const { solve(rhs, lambda, nullptr); }
+  void solve(const Matrix3& rhs, Matrix3& lambda) const;
   // out = G_d vd + G_c vc (rows x 3), 0 in the components a row leaves free.
   void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
@@ -105,8 +106,6 @@ class MultiplierSolver {
   // lambda = A^-1 rhs, every system at once: the products with U and U^T read U once for the
   // three components; with `dc`, dc = M_c^-1 G_c^T lambda on U's columns (the rest untouched).
   void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
-  // solve() that, with the low-rank form and `dc`, also sets dc as solve_low_rank does.
-  void solve(const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
   // The components system k serves (the first `width` entries) and their number.
   std::pair<std::array<int, 3>, int> served_by(int k) const;
   // The system of an earlier component with the same continuum inverse masses and ties (the DEs'

@@ -553,6 +553,15 @@ Vec3 DemModel::mean_velocity(int group) const {
   return group_mean(group, [&](std::size_t i) { return particles.velocity[i]; });
 }
 
+namespace {
+// A DE's row of the frequency bound with the contacts touching it now (its bonds' row plus each
+// contact's), 1/s^2; 0 for a DE that touches none (its bonds alone were checked at set-up). A
+// select, not a branch: whether a DE touches another is a coin toss in a packing.
+inline double crowding_bound(double bonds, double per_contact, std::uint32_t touching) {
+  return touching > 0 ? bonds + per_contact * touching : 0.0;
+}
+}  // namespace
+
 void DemModel::check_finite() const {
   const ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
@@ -569,19 +578,21 @@ void DemModel::check_finite() const {
   const double* bond_bound = bond_frequency_bound_.data();
   const double* contact_bound = contact_bound_each_.data();
   const bool contact = contact_ != nullptr;
+  const auto probe_of = [v, w](long i) {
+    return ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
+  };
   const long chunks = scan_fixed_chunks(n, parallel_threshold, finite_chunks_, [&](long begin, long end) {
     double probe = 0.0, reach2 = 0.0, omega2 = 0.0;
     if (contact) {
 #pragma omp simd reduction(+ : probe) reduction(max : reach2, omega2)
       for (long i = begin; i < end; ++i) {
-        probe += ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
+        probe += probe_of(i);
         reach2 = std::max(reach2, norm2(v[i]) / (radius[i] * radius[i]));
-        omega2 = std::max(omega2, touching[i] > 0 ? bond_bound[i] + contact_bound[i] * touching[i] : 0.0);
+        omega2 = std::max(omega2, crowding_bound(bond_bound[i], contact_bound[i], touching[i]));
       }
     } else {
 #pragma omp simd reduction(+ : probe)
-      for (long i = begin; i < end; ++i)
-        probe += ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
+      for (long i = begin; i < end; ++i) probe += probe_of(i);
     }
     return FiniteScan{!(probe == 0.0), reach2, omega2};
   });
@@ -610,9 +621,8 @@ void DemModel::diagnose() const {
     }
     if (!contact_) continue;
     if (const double r = norm(p.velocity[i]) * last_dt_ / p.radius[i]; r > worst.reach) worst.reach = r, worst.fastest = i;
-    if (touching_[i] > 0)
-      if (const double row = bond_frequency_bound_[i] + contact_bound_each_[i] * touching_[i]; row > worst.omega2)
-        worst.omega2 = row, worst.crowded = i;
+    if (const double row = crowding_bound(bond_frequency_bound_[i], contact_bound_each_[i], touching_[i]); row > worst.omega2)
+      worst.omega2 = row, worst.crowded = i;
   }
   if (bad == 0 && contact_) check_contact_resolution(worst);
   if (bad == 0) return;

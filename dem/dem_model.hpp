@@ -232,7 +232,6 @@ class DemModel {
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
-  // check_finite's scan of one chunk of DEs.
   struct FiniteScan {  // check_finite's pass over a chunk of DEs
     bool bad = false;     // a non-finite velocity
     double reach2 = 0.0;  // the largest |v|^2 / R^2, 1/s^2
