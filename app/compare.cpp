@@ -134,16 +134,80 @@ Json describe_run(const Run& r) {
   return j;
 }
 
+// One sensor column of run b against the reference run a (the header's definitions).
+struct Difference {
+  double max_rel = 0, rms_rel = 0, peak_rel = 0;
+};
+
+Difference difference(const Run& a, const Run& b, const std::string& name) {
+  const auto va = a.column(name), vb = resample(b.column("time"), b.column(name), a.column("time"));
+  double max_diff = 0, max_ref = 0, max_other = 0, sum_diff = 0, sum_ref = 0;
+  for (std::size_t k = 0; k < va.size(); ++k) {
+    const double d = vb[k] - va[k];
+    max_diff = std::max(max_diff, std::abs(d));
+    max_ref = std::max(max_ref, std::abs(va[k]));
+    sum_diff += d * d;
+    sum_ref += va[k] * va[k];
+  }
+  for (double v : b.column(name)) max_other = std::max(max_other, std::abs(v));  // its own peak, not resampled
+  const double ref = std::max(max_ref, 1e-300);
+  return {max_diff / ref, std::sqrt(sum_diff / std::max(sum_ref, 1e-300)), (max_other - max_ref) / ref};
+}
+
+// b's first break relative to a's; none where either run has no break.
+std::optional<double> first_break_difference(const Run& a, const Run& b) {
+  if (!a.first_break || !b.first_break) return std::nullopt;
+  return (*b.first_break - *a.first_break) / *a.first_break;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A figure of the pairs: the value of one pair, or the median and the range of several; in %.
+std::string figure(const std::vector<double>& v, bool sign) {
+  const char* one = sign ? "%+.3g %%" : "%.3g %%";
+  char text[128];
+  if (v.size() == 1) {
+    std::snprintf(text, sizeof text, one, 100 * v[0]);
+  } else {
+    const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+    std::snprintf(text, sizeof text, sign ? "%+.3g %% (%+.3g to %+.3g %%)" : "%.3g %% (%.3g to %.3g %%)",
+                  100 * median(v), 100 * *lo, 100 * *hi);
+  }
+  return text;
+}
+
+double largest_magnitude(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+Json numbers(const std::vector<double>& v) {
+  Json j = Json::array();
+  for (double x : v) j.push_back(x);
+  return j;
+}
+
 }  // namespace
 
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
-                 const SceneOptions& base, const std::filesystem::path& out_dir) {
+                           const SceneOptions& base, const std::filesystem::path& out_dir, int ensemble) {
   std::error_code ec;
   if (std::filesystem::equivalent(reference_case, other_case, ec))
     std::fprintf(stderr, "arlequin compare: warning: both runs are %s; the differences are run-to-run noise\n",
                  reference_case.string().c_str());
-  Prepared prepared_a = prepare(reference_case, base, out_dir / "reference");
-  Prepared prepared_b = prepare(other_case, base, out_dir / "other");
+  const auto pair_dir = [&](int k) { return k == 0 ? out_dir : out_dir / ("pair_" + std::to_string(k)); };
+  const auto pair_options = [&](int k) {
+    SceneOptions options = base;
+    options.time_step_scale = 1.0 - k * ensemble_time_step_perturbation;
+    return options;
+  };
+  Prepared prepared_a = prepare(reference_case, pair_options(0), out_dir / "reference");
+  Prepared prepared_b = prepare(other_case, pair_options(0), out_dir / "other");
   // Shared sensor columns (the energy totals mean different things for a DEM and a coupled run).
   const std::vector<std::string> sensors_a = sensor_columns(*prepared_a.scene), sensors_b = sensor_columns(*prepared_b.scene);
   const std::vector<std::string> units_a = sensor_units(*prepared_a.scene);
@@ -153,74 +217,150 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       shared.push_back(sensors_a[k]), shared_units.push_back(units_a[k]);
   if (shared.empty())
     throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
-  const Run a = execute(prepared_a, out_dir / "reference");
-  prepared_a.scene.reset();  // the first run's memory, before the second run
-  const Run b = execute(prepared_b, out_dir / "other");
 
-  const auto ta = a.column("time"), tb = b.column("time");
+  // The pairs, one run at a time (a scene's memory freed before the next is built).
+  std::vector<Run> reference_runs, other_runs;
+  for (int k = 0; k < ensemble; ++k) {
+    if (ensemble > 1)
+      std::printf("pair %d of 0..%d: time steps x (1 - %d x %.0e)\n", k, ensemble - 1, k, ensemble_time_step_perturbation);
+    if (k > 0) prepared_a = prepare(reference_case, pair_options(k), pair_dir(k) / "reference");
+    reference_runs.push_back(execute(prepared_a, pair_dir(k) / "reference"));
+    prepared_a.scene.reset();
+    if (k > 0) prepared_b = prepare(other_case, pair_options(k), pair_dir(k) / "other");
+    other_runs.push_back(execute(prepared_b, pair_dir(k) / "other"));
+    prepared_b.scene.reset();
+  }
+  const Run& a = reference_runs[0];
+  const Run& b = other_runs[0];
+  const std::size_t pairs = reference_runs.size();
+
   Json sensors = Json::array();
-  std::string csv = "sensor,max_relative_difference,rms_relative_difference,peak_relative_difference\n";
+  std::string csv = "sensor,max_relative_difference,rms_relative_difference,peak_relative_difference";
+  if (pairs > 1)
+    csv += ",max_relative_min,max_relative_max,peak_relative_min,peak_relative_max,reference_spread_max_relative,"
+           "reference_spread_peak_min,reference_spread_peak_max";
+  csv += "\n";
   std::vector<Plot> plots;
-  std::printf("| sensor | max rel. difference | RMS rel. difference | peak rel. difference |\n|---|---|---|---|\n");
+  if (pairs > 1)
+    std::printf("%zu pairs: the median over them (lowest to highest); the reference's own spread is its runs of pairs "
+                "1..%zu against its run of pair 0\n", pairs, pairs - 1);
+  std::printf("| sensor | max rel. difference | RMS rel. difference | peak rel. difference |%s\n|---|---|---|---|%s\n",
+              pairs > 1 ? " reference's own spread: max rel., peak |" : "", pairs > 1 ? "---|" : "");
   for (std::size_t s = 0; s < shared.size(); ++s) {
     const std::string& name = shared[s];
-    const auto va = a.column(name), vb = resample(tb, b.column(name), ta);
-    double max_diff = 0, max_ref = 0, max_other = 0, sum_diff = 0, sum_ref = 0;
-    for (std::size_t k = 0; k < va.size(); ++k) {
-      const double d = vb[k] - va[k];
-      max_diff = std::max(max_diff, std::abs(d));
-      max_ref = std::max(max_ref, std::abs(va[k]));
-      sum_diff += d * d;
-      sum_ref += va[k] * va[k];
+    std::vector<double> max_rel, rms_rel, peak_rel, spread, peak_spread;
+    for (std::size_t k = 0; k < pairs; ++k) {
+      const Difference d = difference(reference_runs[k], other_runs[k], name);
+      max_rel.push_back(d.max_rel), rms_rel.push_back(d.rms_rel), peak_rel.push_back(d.peak_rel);
+      if (k > 0) {
+        const Difference own = difference(a, reference_runs[k], name);
+        spread.push_back(own.max_rel), peak_spread.push_back(own.peak_rel);
+      }
     }
-    for (double v : b.column(name)) max_other = std::max(max_other, std::abs(v));  // its own peak, not resampled
-    const double max_rel = max_diff / std::max(max_ref, 1e-300), rms_rel = std::sqrt(sum_diff / std::max(sum_ref, 1e-300));
-    const double peak_rel = (max_other - max_ref) / std::max(max_ref, 1e-300);
     Json j = Json::object();
     j["sensor"] = name;
-    j["max_relative_difference"] = max_rel;
-    j["rms_relative_difference"] = rms_rel;
-    j["peak_relative_difference"] = peak_rel;
-    sensors.push_back(j);
-    char row[256];
-    std::snprintf(row, sizeof row, "%s,%.6g,%.6g,%.6g\n", name.c_str(), max_rel, rms_rel, peak_rel);
+    j["max_relative_difference"] = median(max_rel);
+    j["rms_relative_difference"] = median(rms_rel);
+    j["peak_relative_difference"] = median(peak_rel);
+    char row[512];
+    std::snprintf(row, sizeof row, "%s,%.6g,%.6g,%.6g", name.c_str(), median(max_rel), median(rms_rel), median(peak_rel));
     csv += row;
-    std::printf("| %s | %.3g %% | %.3g %% | %+.3g %% |\n", name.c_str(), 100 * max_rel, 100 * rms_rel, 100 * peak_rel);
+    if (pairs > 1) {
+      Json members = Json::object();
+      members["max_relative_difference"] = numbers(max_rel);
+      members["rms_relative_difference"] = numbers(rms_rel);
+      members["peak_relative_difference"] = numbers(peak_rel);
+      j["pairs"] = members;
+      j["reference_spread_max_relative"] = numbers(spread);
+      j["reference_spread_peak_relative"] = numbers(peak_spread);
+      const auto [max_lo, max_hi] = std::minmax_element(max_rel.begin(), max_rel.end());
+      const auto [peak_lo, peak_hi] = std::minmax_element(peak_rel.begin(), peak_rel.end());
+      const auto [own_lo, own_hi] = std::minmax_element(peak_spread.begin(), peak_spread.end());
+      std::snprintf(row, sizeof row, ",%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", *max_lo, *max_hi, *peak_lo, *peak_hi,
+                    largest_magnitude(spread), *own_lo, *own_hi);
+      csv += row;
+    }
+    csv += "\n";
+    sensors.push_back(j);
+    std::printf("| %s | %s | %s | %s |", name.c_str(), figure(max_rel, false).c_str(), figure(rms_rel, false).c_str(),
+                figure(peak_rel, true).c_str());
+    if (pairs > 1) {
+      const auto [own_lo, own_hi] = std::minmax_element(peak_spread.begin(), peak_spread.end());
+      std::printf(" up to %.3g %%, %+.3g to %+.3g %% |", 100 * largest_magnitude(spread), 100 * *own_lo, 100 * *own_hi);
+    }
+    std::printf("\n");
+    // Pair 0's two histories named in the legend, the further pairs' drawn dashed behind them.
     Plot& plot = plots.emplace_back();
     plot.file = "compare_" + name + ".png";
-    plot.title = name + ": " + b.name + " against " + a.name;
+    plot.title = name + ": " + b.name + " against " + a.name + (pairs > 1 ? " (" + std::to_string(pairs) + " pairs)" : "");
     plot.x_label = "time [s]";
     plot.y_label = shared_units[s] == "1" ? name : name + " [" + shared_units[s] + "]";
-    plot.curves.resize(2);
-    plot.curves[0].label = a.name, plot.curves[0].x = ta, plot.curves[0].y = va;
-    plot.curves[1].label = b.name, plot.curves[1].x = tb, plot.curves[1].y = b.column(name);
+    for (std::size_t k = 0; k < pairs; ++k)
+      for (const Run* r : {&reference_runs[k], &other_runs[k]}) {
+        PlotCurve& curve = plot.curves.emplace_back();
+        curve.label = k == 0 ? r->name : "";
+        curve.style = k == 0 ? PlotCurve::Style::line : PlotCurve::Style::dashed;
+        curve.x = r->column("time"), curve.y = r->column(name);
+      }
   }
-  const double speedup = a.compute_seconds() / std::max(b.compute_seconds(), 1e-12);
-  std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", a.name.c_str(),
-              a.particles, a.nodes, a.steps, a.compute_seconds(), a.setup, a.output);
-  std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", b.name.c_str(),
-              b.particles, b.nodes, b.steps, b.compute_seconds(), b.setup, b.output);
-  std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
+
+  std::vector<double> speedups, first_breaks, reference_first_breaks;
+  for (std::size_t k = 0; k < pairs; ++k) {
+    speedups.push_back(reference_runs[k].compute_seconds() / std::max(other_runs[k].compute_seconds(), 1e-12));
+    if (const auto d = first_break_difference(reference_runs[k], other_runs[k])) first_breaks.push_back(*d);
+    if (const auto d = first_break_difference(a, reference_runs[k]); d && k > 0) reference_first_breaks.push_back(*d);
+  }
+  const double speedup = median(speedups);
+  for (const Run* r : {&a, &b})
+    std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", r->name.c_str(),
+                r->particles, r->nodes, r->steps, r->compute_seconds(), r->setup, r->output);
+  if (pairs == 1) {
+    std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
+  } else {
+    const auto [lo, hi] = std::minmax_element(speedups.begin(), speedups.end());
+    std::printf("speed-up of %s over %s (compute): %.2fx (%.2fx to %.2fx)\n", b.name.c_str(), a.name.c_str(), speedup,
+                *lo, *hi);
+  }
   for (const Run* r : {&a, &b}) {
     std::printf("%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(), r->dem_energy(),
                 r->continuum_energy(), r->last("E_fracture"));
     if (r->first_break) std::printf("; first break at %.4g s", *r->first_break);
     std::printf("\n");
   }
-  if (a.first_break && b.first_break)
-    std::printf("first break: %+.3g %% of the reference's\n", 100 * (*b.first_break - *a.first_break) / *a.first_break);
-  for (const Run* r : {&a, &b})
-    if (!r->checks_passed) std::printf("%s: a check of its case FAILED (its summary.json says which)\n", r->name.c_str());
+  if (!first_breaks.empty()) {
+    std::printf("first break: %s of the reference's", figure(first_breaks, true).c_str());
+    if (!reference_first_breaks.empty())
+      std::printf("; the reference's own spread up to %.3g %%", 100 * largest_magnitude(reference_first_breaks));
+    std::printf("\n");
+  }
+  bool completed = true, checks_passed = true;
+  for (std::size_t k = 0; k < pairs; ++k)
+    for (const Run* r : {&reference_runs[k], &other_runs[k]}) {
+      completed = completed && r->ok;
+      checks_passed = checks_passed && r->checks_passed;
+      if (!r->checks_passed)
+        std::printf("%s%s: a check of its case FAILED (its summary.json says which)\n", r->name.c_str(),
+                    pairs > 1 ? (" (pair " + std::to_string(k) + ")").c_str() : "");
+    }
 
   Json report = Json::object();
   report["reference"] = describe_run(a);
   report["other"] = describe_run(b);
   report["speedup_compute"] = speedup;
   report["sensors"] = sensors;
+  if (pairs > 1) {
+    Json e = Json::object();
+    e["pairs"] = pairs;
+    e["time_step_perturbation"] = ensemble_time_step_perturbation;
+    e["speedup_compute"] = numbers(speedups);
+    e["first_break_relative_difference"] = numbers(first_breaks);
+    e["reference_spread_first_break"] = numbers(reference_first_breaks);
+    report["ensemble"] = e;
+  }
   write_file_atomically(out_dir / "compare.csv", csv);
   write_json_atomically(out_dir / "compare.json", report);
   write_plots(out_dir, plots);
-  return {a.ok && b.ok, a.checks_passed && b.checks_passed};
+  return {completed, checks_passed};
 }
 
 }  // namespace arlequin::app

@@ -10,6 +10,13 @@
 // fracture) and first break (summary.json), and the second's first break relative to the first's.
 // Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors) and one PNG
 // per sensor overlaying both time histories, into the output folder (atomically).
+//
+// An ensemble (`--ensemble N`, docs/decisions.md#d44) runs N pairs: pair k with both cases' time
+// steps scaled by 1 - k 1e-9, a perturbation far below either model's discretisation error that
+// changes the last bits of every step. Where the runs are chaotic (contacts and breakage) each
+// pair is one draw; the figures above are then the median over the pairs with their range, and
+// the reference's runs k >= 1 against its run 0 give the reference's own spread, below which no
+// difference means anything.
 #pragma once
 #include <filesystem>
 
@@ -23,9 +30,14 @@ struct CompareOutcome {
   bool checks_passed = true;
 };
 
-// Builds both scenes, then runs them one after the other, each judged by its own checks.
-// InputError, before any run, when a case is bad or the cases share no sensor column.
+// The relative change of the time step between two pairs of an ensemble.
+inline constexpr double ensemble_time_step_perturbation = 1e-9;
+
+// Builds both scenes, then runs them one after the other, each judged by its own checks; with
+// ensemble > 1, the further pairs after them (each pair's scenes built just before it runs).
+// Pair 0 writes to out_dir/reference and out_dir/other, pair k to out_dir/pair_k/... InputError,
+// before any run, when a case is bad or the cases share no sensor column.
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
-                 const SceneOptions& base, const std::filesystem::path& out_dir);
+                           const SceneOptions& base, const std::filesystem::path& out_dir, int ensemble = 1);
 
 }  // namespace arlequin::app

@@ -77,12 +77,15 @@ constexpr const char* usage_build_sample =
     "  cache file matches), stores it in the cache file and prints its report and radius histogram\n";
 
 constexpr const char* usage_compare =
-    "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--set k=v ...]\n"
+    "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--ensemble N] [--set k=v ...]\n"
     "  builds both cases first (a bad case, or none of their sensors shared, stops it before any\n"
     "  run), runs them (results in DIR/reference and DIR/other, default results/compare), then for\n"
     "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
     "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
-    "  compare_<sensor>.png. Each run is judged by its own case's checks: exit 5 if one fails\n";
+    "  compare_<sensor>.png. Each run is judged by its own case's checks: exit 5 if one fails.\n"
+    "  --ensemble N: N pairs, pair k with both time steps x (1 - k 1e-9) (results of k >= 1 in\n"
+    "  DIR/pair_k/): the median and range over the pairs, and the reference's own spread; for runs\n"
+    "  whose outcome is a draw (contacts, breakage; docs/decisions.md#d44)\n";
 
 constexpr const char* usage_virtual_test =
     "usage: arlequin virtual-test SPEC.yaml [--out DIR] [--sample NAME ...] [--test NAME ...] [--set k=v ...] [--profile]\n"
@@ -125,6 +128,7 @@ struct Arguments {
   std::string document = "case";     // schema --of
   bool quiet = false;
   bool help = false;
+  int ensemble = 1;                  // compare --ensemble
 };
 
 Arguments parse(int argc, char** argv) {
@@ -164,6 +168,12 @@ Arguments parse(int argc, char** argv) {
       char* end = nullptr;
       a.steps = std::strtol(v.c_str(), &end, 10);
       if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+    } else if (arg == "--ensemble" && a.command == "compare") {
+      const std::string v = value("a number of pairs");
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (*end != '\0' || n < 1 || n > 1000) throw InputError("--ensemble: expected a whole number of pairs from 1 to 1000, got '" + v + "'");
+      a.ensemble = int(n);
     } else if (arg == "--restart" && a.command == "run") {
       a.restart = value("a checkpoint file");
     } else if (arg == "--of" && a.command == "schema") {
@@ -342,7 +352,7 @@ int compare(const Arguments& a) {
   if (out.empty()) out = "results/compare";
   app::SceneOptions base = a.scene;
   base.out_dir.clear();
-  const app::CompareOutcome outcome = app::run_compare(a.case_file, a.second_case, base, out);
+  const app::CompareOutcome outcome = app::run_compare(a.case_file, a.second_case, base, out, a.ensemble);
   std::printf("comparison: %s (compare.csv, compare.json, compare_<sensor>.png)\n",
               std::filesystem::absolute(out).string().c_str());
   if (!outcome.completed) return 3;

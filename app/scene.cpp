@@ -153,6 +153,8 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       time->fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
     scene.dt = scene.safety * scene.dt_critical;
   }
+  // Only ever smaller (an ensemble's perturbation), so a step under the limit stays under it.
+  if (!static_only) scene.dt *= std::min(options.time_step_scale, 1.0);
   if (scene.end_time < 1e-9 * scene.dt) {
     std::ostringstream msg;
     msg << "time.end = " << scene.end_time << " s is not even 1e-9 of a time step (dt = " << scene.dt << " s): no step would run";

@@ -967,6 +967,40 @@ TEST(Cli, CompareBoundsTheCoupledErrorAndHonoursChecks) {
   EXPECT_FALSE(read_json_file(out / "failing" / "compare.json").at("other").at("checks_passed").get<bool>());
 }
 
+// compare --ensemble: pairs of runs with both time steps moved by k 1e-9 (docs/decisions.md#d44).
+// The wave bar is linear, not chaotic: the perturbation moves its runs in proportion to it (the
+// reference's own spread 1.3e-9 and 2.5e-9 of the probe's largest value for pairs 1 and 2,
+// bounded at 1e-8; zero would mean no perturbation), every pair then tells the same (to 4e-8 of
+// the difference, bounded at 2e-7), and the figure reported is the median over the pairs.
+TEST(Cli, CompareEnsembleReportsTheMedianAndTheReferencesOwnSpread) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("compare_ensemble");
+  const auto r = test::run_arlequin("compare " + cases + "wave_bar_dem/case.yaml " + cases + "wave_bar_coupled/case.yaml"
+                                    " --ensemble 3 --set time.end=2e-3 --set output.fields=[] --set checks=[] --out " +
+                                        out.string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* run : {"pair_1/reference", "pair_1/other", "pair_2/reference", "pair_2/other"})
+    EXPECT_TRUE(std::filesystem::exists(out / run / "series.csv")) << run;
+  const Json c = read_json_file(out / "compare.json");
+  ASSERT_EQ(c.at("ensemble").at("pairs").get<int>(), 3);
+  const Json& probe = c.at("sensors").at(1);
+  ASSERT_EQ(probe.at("sensor").get<std::string>(), "u_probe");
+  std::vector<double> pairs = probe.at("pairs").at("max_relative_difference").get<std::vector<double>>();
+  ASSERT_EQ(pairs.size(), 3u);
+  const std::vector<double> spread = probe.at("reference_spread_max_relative").get<std::vector<double>>();
+  ASSERT_EQ(spread.size(), 2u);
+  for (double s : spread) {
+    EXPECT_GT(s, 0.0);
+    EXPECT_LT(s, 1e-8);
+  }
+  for (double p : pairs) EXPECT_NEAR(p, pairs[0], 2e-7 * pairs[0]);
+  std::sort(pairs.begin(), pairs.end());
+  EXPECT_EQ(probe.at("max_relative_difference").get<double>(), pairs[1]);
+  EXPECT_NE(r.output.find("reference's own spread"), std::string::npos) << r.output;
+}
+
 // case.resolved.yaml (also what `arlequin check` prints) is a case file: read back, it resolves
 // to itself (box regions as [[x, y, z], [x, y, z]], defaults included).
 TEST(Cases, ResolvedCaseReadsBackToItself) {
