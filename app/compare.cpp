@@ -221,8 +221,10 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   // The pairs, one run at a time (a scene's memory freed before the next is built).
   std::vector<Run> reference_runs, other_runs;
   for (int k = 0; k < ensemble; ++k) {
-    if (ensemble > 1)
+    if (ensemble > 1) {
       std::printf("pair %d of 0..%d: time steps x (1 - %d x %.0e)\n", k, ensemble - 1, k, ensemble_time_step_perturbation);
+      std::fflush(stdout);  // before the runs' own lines
+    }
     if (k > 0) prepared_a = prepare(reference_case, pair_options(k), pair_dir(k) / "reference");
     reference_runs.push_back(execute(prepared_a, pair_dir(k) / "reference"));
     prepared_a.scene.reset();

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "common/json.hpp"
 #include "support/cli.hpp"
@@ -275,22 +276,25 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
   EXPECT_GT(coarse_R, 0.2);
 }
 
-// Validation: the coupled seed target against the pure-DEM run (`arlequin compare`, both with
-// breakage, about 40 s): the bounds, the sphere's velocity history within 5 % (max
-// relative over the 100 us; measured 2.03 % of its largest value), the peak impact force within
-// 10 % (measured -1.25 %, rows every 0.1 us), the first break within 10 % (measured -1.47 %); and
-// without breakage the coupled balance within 1 % of the impact energy (measured 2.9e-4). With
-// breakage the differences move with the last bits of the arithmetic: the case's README says what
-// a breaking weave's comparison can resolve.
+// Validation: the coupled seed target against the pure-DEM run, both with breakage. One comparison
+// is one draw (docs/decisions.md#d43), so the bounds are asserted on the medians of seven
+// pairs (`arlequin compare --ensemble 7`, d44; about 5 minutes): the sphere's velocity history
+// within 5 % (max over the 100 us of the difference relative to its largest value: measured
+// 3.67 %, the pairs 1.71 to 5.99 %, the pure run against itself up to 2.27 %), the peak impact
+// force within 10 % (measured -6.11 %, rows every 0.1 us), the first break within 10 % (measured
+// -0.01 %); and without breakage the coupled balance within 1 % of the impact energy (measured
+// 2.9e-4).
 TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("fabric_compare");
   const std::string pure = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/fabric_impact/case.yaml";
-  const auto r = test::run_arlequin("compare " + pure + " " + coupled_dir + "case.yaml --set output.fields=[] --out " + out.string());
+  const auto r = test::run_arlequin("compare " + pure + " " + coupled_dir + "case.yaml --ensemble 7 --set output.fields=[] --out " +
+                                    out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json report = Json::parse(test::read_text(out / "compare.json"));
+  ASSERT_EQ(report.at("ensemble").at("pairs").get<int>(), 7);
   for (const auto& sensor : report.at("sensors")) {
     const std::string name = sensor.at("sensor").get<std::string>();
     if (name == "sphere_velocity") {
@@ -300,9 +304,10 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
       EXPECT_LT(std::abs(sensor.at("peak_relative_difference").get<double>()), 0.10);
     }
   }
-  const double first_pure = report.at("reference").at("first_break_time").get<double>();
-  const double first_coupled = report.at("other").at("first_break_time").get<double>();
-  EXPECT_LT(std::abs(first_coupled / first_pure - 1.0), 0.10);
+  std::vector<double> first_breaks = report.at("ensemble").at("first_break_relative_difference").get<std::vector<double>>();
+  ASSERT_EQ(first_breaks.size(), 7u);
+  std::sort(first_breaks.begin(), first_breaks.end());
+  EXPECT_LT(std::abs(first_breaks[3]), 0.10);
 
   const auto unbreakable = test::scratch_dir("fabric_coupled_seed_unbreakable");
   const auto u = test::run_arlequin("run " + coupled_dir + "case.yaml --set dem.sample.yarn.failure_strain=0 --set output.fields=[] --out " +
