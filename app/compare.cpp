@@ -291,7 +291,7 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       std::printf(" up to %.3g %%, %+.3g to %+.3g %% |", 100 * largest_magnitude(spread), 100 * *own_lo, 100 * *own_hi);
     }
     std::printf("\n");
-    // Pair 0's two histories named in the legend, the further pairs' drawn dashed behind them.
+    // Pair 0's two histories named in the legend, the further pairs' dashed in their run's colour.
     Plot& plot = plots.emplace_back();
     plot.file = "compare_" + name + ".png";
     plot.title = name + ": " + b.name + " against " + a.name + (pairs > 1 ? " (" + std::to_string(pairs) + " pairs)" : "");
@@ -302,6 +302,7 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
         PlotCurve& curve = plot.curves.emplace_back();
         curve.label = k == 0 ? r->name : "";
         curve.style = k == 0 ? PlotCurve::Style::line : PlotCurve::Style::dashed;
+        curve.colour = r == &reference_runs[k] ? 0 : 1;
         curve.x = r->column("time"), curve.y = r->column(name);
       }
   }

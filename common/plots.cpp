@@ -43,6 +43,7 @@ Json plot_json(const Plot& plot) {
     s["label"] = c.label;
     s["style"] = style_name(c.style);
     s["right_axis"] = c.right_axis;
+    if (c.colour >= 0) s["colour"] = c.colour;
     if (!c.csv.empty()) {
       s["csv"] = c.csv;
       s["x"] = c.x_column;

@@ -17,6 +17,7 @@ struct PlotCurve {
   std::string label;  // legend text; empty: left out of the legend
   Style style = Style::line;
   bool right_axis = false;
+  int colour = -1;  // the default colour cycle's entry to draw in; -1: the next one
   // Either columns of a CSV file in the results folder, multiplied by the scales...
   std::string csv{}, x_column{}, y_column{};
   double x_scale = 1.0, y_scale = 1.0;

@@ -77,6 +77,9 @@ def _check_series(series, where):
     _expect(isinstance(series.get("label", ""), str), f"{where}.label", "a string")
     _expect(series.get("style", "line") in STYLES, f"{where}.style", " or ".join(f'"{s}"' for s in STYLES))
     _expect(isinstance(series.get("right_axis", False), bool), f"{where}.right_axis", "true or false")
+    colour = series.get("colour", 0)
+    _expect(isinstance(colour, int) and not isinstance(colour, bool) and colour >= 0, f"{where}.colour",
+            "a whole number >= 0")
     from_csv = "csv" in series
     inline = "x_values" in series or "y_values" in series
     _expect(from_csv != inline, where, 'either "csv", "x", "y" or "x_values", "y_values"')
@@ -141,8 +144,9 @@ def figure(results_dir, plot, tables=None):
             continue
         x, y = _drop_unplottable(*data, log_x, plot.get("log_y2" if on_right else "log_y", False))
         label = series.get("label", "")
+        colour = series.get("colour", len(handles))  # the cycle's next, unless the series names one
         (line,) = (right if on_right else left).plot(
-            x, y, color=colours[len(handles) % len(colours)], label=label or "_nolegend_",
+            x, y, color=colours[colour % len(colours)], label=label or "_nolegend_",
             **STYLES[series.get("style", "line")])
         handles.append(line)
     left.set_title(plot.get("title", ""))

@@ -114,6 +114,17 @@ def test_legend_has_both_axes_and_colours_differ(results):
     assert fig.axes[1].get_ylabel() == "broken %"
 
 
+def test_a_named_colour_overrides_the_cycle(results):
+    spec = {"file": "a.png", "series": [
+        csv_series("energy", label="a"), csv_series("energy", label="b"),
+        csv_series("energy", colour=0, style="dashed"), csv_series("energy", colour=11)]}
+    fig = plot.figure(results.path, spec)
+    from matplotlib import rcParams
+    cycle = rcParams["axes.prop_cycle"].by_key()["color"]
+    colours = [to_hex(line.get_color()) for line in fig.axes[0].get_lines()]
+    assert colours == [to_hex(c) for c in (cycle[0], cycle[1], cycle[0], cycle[11 % len(cycle)])]
+
+
 def test_labels_title_and_styles(results):
     spec = {"file": "a.png", "title": "Tension", "x_label": "strain", "y_label": "stress GPa", "series": [
         csv_series("energy", style="points"), csv_series("energy", style="line_points"), csv_series("energy")]}
@@ -220,6 +231,8 @@ def test_unknown_format_exits_2(results):
     '{"plots": [{"file": "a.png", "series": [{"csv": "s.csv", "x": "t", "y": "u", "y_scale": "2"}]}]}',
     '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": ["1"]}]}]}',
     '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "style": "bars"}]}]}',
+    '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "colour": -1}]}]}',
+    '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "colour": "C0"}]}]}',
 ])
 def test_bad_plots_json_exits_2_with_one_line(results, text):
     (results.path / "plots.json").write_text(text)
