@@ -151,7 +151,8 @@ TEST(Cases, ExtremumChecksOverARangeOfAnotherColumn) {
 }
 
 // compare builds both scenes before it runs either: a bad second case, or two cases with no
-// sensor in common, cost no run. sweep refuses an axis without values.
+// sensor in common, cost no run, nor does --ensemble without a whole number of pairs. sweep refuses an axis
+// without values.
 TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
   const auto out = test::scratch_dir("compare_bad");
   auto r = test::run_arlequin("compare " + cases + "cantilever_chain/case.yaml " + cases + "wave_bar_dem/case.yaml --out " +
@@ -164,6 +165,9 @@ TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("missing.yaml: cannot open case file"), std::string::npos) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out / "reference" / "series.csv"));
+  r = test::run_arlequin("compare " + cases + "cantilever_chain/case.yaml " + cases + "cantilever_chain/case.yaml --ensemble 0");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--ensemble: expected a whole number of pairs from 1 to 1000, got '0'"), std::string::npos) << r.output;
   r = test::run_arlequin("sweep " + cases + "cantilever_chain/case.yaml --over dem.damping=,,");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--over dem.damping=,,: no values after '='"), std::string::npos) << r.output;
