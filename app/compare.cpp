@@ -217,6 +217,9 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       shared.push_back(sensors_a[k]), shared_units.push_back(units_a[k]);
   if (shared.empty())
     throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
+  if (ensemble > 1 && prepared_a.scene->static_only() && prepared_b.scene->static_only())
+    throw InputError("--ensemble " + std::to_string(ensemble) + ": both cases are static solves, which have no time step to "
+                     "perturb: every pair would be the same");
 
   // The pairs, one run at a time (a scene's memory freed before the next is built).
   std::vector<Run> reference_runs, other_runs;
@@ -250,7 +253,7 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
               pairs > 1 ? " reference's own spread: max rel., peak |" : "", pairs > 1 ? "---|" : "");
   for (std::size_t s = 0; s < shared.size(); ++s) {
     const std::string& name = shared[s];
-    std::vector<double> max_rel, rms_rel, peak_rel, spread, peak_spread;
+    std::vector<double> max_rel, rms_rel, peak_rel, spread, peak_spread;  // spread: the reference's, max rel.
     for (std::size_t k = 0; k < pairs; ++k) {
       const Difference d = difference(reference_runs[k], other_runs[k], name);
       max_rel.push_back(d.max_rel), rms_rel.push_back(d.rms_rel), peak_rel.push_back(d.peak_rel);
@@ -258,6 +261,12 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
         const Difference own = difference(a, reference_runs[k], name);
         spread.push_back(own.max_rel), peak_spread.push_back(own.peak_rel);
       }
+    }
+    double spread_largest = 0, own_lo = 0, own_hi = 0;
+    if (pairs > 1) {
+      spread_largest = largest_magnitude(spread);
+      const auto [lo, hi] = std::minmax_element(peak_spread.begin(), peak_spread.end());
+      own_lo = *lo, own_hi = *hi;
     }
     Json j = Json::object();
     j["sensor"] = name;
@@ -277,19 +286,15 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       j["reference_spread_peak_relative"] = numbers(peak_spread);
       const auto [max_lo, max_hi] = std::minmax_element(max_rel.begin(), max_rel.end());
       const auto [peak_lo, peak_hi] = std::minmax_element(peak_rel.begin(), peak_rel.end());
-      const auto [own_lo, own_hi] = std::minmax_element(peak_spread.begin(), peak_spread.end());
       std::snprintf(row, sizeof row, ",%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", *max_lo, *max_hi, *peak_lo, *peak_hi,
-                    largest_magnitude(spread), *own_lo, *own_hi);
+                    spread_largest, own_lo, own_hi);
       csv += row;
     }
     csv += "\n";
     sensors.push_back(j);
     std::printf("| %s | %s | %s | %s |", name.c_str(), figure(max_rel, false).c_str(), figure(rms_rel, false).c_str(),
                 figure(peak_rel, true).c_str());
-    if (pairs > 1) {
-      const auto [own_lo, own_hi] = std::minmax_element(peak_spread.begin(), peak_spread.end());
-      std::printf(" up to %.3g %%, %+.3g to %+.3g %% |", 100 * largest_magnitude(spread), 100 * *own_lo, 100 * *own_hi);
-    }
+    if (pairs > 1) std::printf(" up to %.3g %%, %+.3g to %+.3g %% |", 100 * spread_largest, 100 * own_lo, 100 * own_hi);
     std::printf("\n");
     // Pair 0's two histories named in the legend, the further pairs' dashed in their run's colour.
     Plot& plot = plots.emplace_back();
@@ -307,16 +312,24 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       }
   }
 
+  // First breaks: per pair, none where a run of the pair has none (null in compare.json).
   std::vector<double> speedups, first_breaks, reference_first_breaks;
+  Json first_break_pairs = Json::array(), reference_first_break_pairs = Json::array();
   for (std::size_t k = 0; k < pairs; ++k) {
     speedups.push_back(reference_runs[k].compute_seconds() / std::max(other_runs[k].compute_seconds(), 1e-12));
-    if (const auto d = first_break_difference(reference_runs[k], other_runs[k])) first_breaks.push_back(*d);
-    if (const auto d = first_break_difference(a, reference_runs[k]); d && k > 0) reference_first_breaks.push_back(*d);
+    const auto d = first_break_difference(reference_runs[k], other_runs[k]);
+    if (d) first_breaks.push_back(*d);
+    first_break_pairs.push_back(d ? Json(*d) : Json());
+    if (k == 0) continue;
+    const auto own = first_break_difference(a, reference_runs[k]);
+    if (own) reference_first_breaks.push_back(*own);
+    reference_first_break_pairs.push_back(own ? Json(*own) : Json());
   }
   const double speedup = median(speedups);
+  const char* of_pair_0 = pairs > 1 ? " (pair 0)" : "";
   for (const Run* r : {&a, &b})
-    std::printf("%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", r->name.c_str(),
-                r->particles, r->nodes, r->steps, r->compute_seconds(), r->setup, r->output);
+    std::printf("%s%s: %zu DEs, %ld nodes, %ld steps, compute %.3f s (setup %.3f s, output %.3f s)\n", r->name.c_str(),
+                of_pair_0, r->particles, r->nodes, r->steps, r->compute_seconds(), r->setup, r->output);
   if (pairs == 1) {
     std::printf("speed-up of %s over %s (compute): %.2fx\n", b.name.c_str(), a.name.c_str(), speedup);
   } else {
@@ -325,13 +338,14 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
                 *lo, *hi);
   }
   for (const Run* r : {&a, &b}) {
-    std::printf("%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(), r->dem_energy(),
-                r->continuum_energy(), r->last("E_fracture"));
+    std::printf("%s%s at the end: DEM %.4g J, continuum %.4g J, fracture %.4g J", r->name.c_str(), of_pair_0,
+                r->dem_energy(), r->continuum_energy(), r->last("E_fracture"));
     if (r->first_break) std::printf("; first break at %.4g s", *r->first_break);
     std::printf("\n");
   }
   if (!first_breaks.empty()) {
     std::printf("first break: %s of the reference's", figure(first_breaks, true).c_str());
+    if (pairs > 1 && first_breaks.size() < pairs) std::printf(" (%zu of %zu pairs broke in both runs)", first_breaks.size(), pairs);
     if (!reference_first_breaks.empty())
       std::printf("; the reference's own spread up to %.3g %%", 100 * largest_magnitude(reference_first_breaks));
     std::printf("\n");
@@ -355,9 +369,10 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
     Json e = Json::object();
     e["pairs"] = pairs;
     e["time_step_perturbation"] = ensemble_time_step_perturbation;
-    e["speedup_compute"] = numbers(speedups);
-    e["first_break_relative_difference"] = numbers(first_breaks);
-    e["reference_spread_first_break"] = numbers(reference_first_breaks);
+    e["speedup_compute_pairs"] = numbers(speedups);
+    if (!first_breaks.empty()) e["first_break_relative_difference"] = median(first_breaks);
+    e["first_break_relative_difference_pairs"] = first_break_pairs;
+    e["reference_spread_first_break_relative"] = reference_first_break_pairs;
     report["ensemble"] = e;
   }
   write_file_atomically(out_dir / "compare.csv", csv);

@@ -36,7 +36,9 @@ inline constexpr double ensemble_time_step_perturbation = 1e-9;
 // Builds both scenes, then runs them one after the other, each judged by its own checks; with
 // ensemble > 1, the further pairs after them (each pair's scenes built just before it runs).
 // Pair 0 writes to out_dir/reference and out_dir/other, pair k to out_dir/pair_k/... InputError,
-// before any run, when a case is bad or the cases share no sensor column.
+// before any run, when a case is bad, the cases share no sensor column, or an ensemble is asked
+// of two static solves. With an ensemble, compare.json's "reference" and "other" and the runs'
+// printed sizes and energies are pair 0's; every difference and the speed-up are medians.
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                            const SceneOptions& base, const std::filesystem::path& out_dir, int ensemble = 1);
 

@@ -83,7 +83,7 @@ constexpr const char* usage_compare =
     "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
     "  both runs' sizes and compute times and the speed-up; writes compare.csv, compare.json and\n"
     "  compare_<sensor>.png. Each run is judged by its own case's checks: exit 5 if one fails.\n"
-    "  --ensemble N: N pairs, pair k with both time steps x (1 - k 1e-9) (results of k >= 1 in\n"
+    "  --ensemble N: N pairs, pair k = 0..N-1 with both time steps x (1 - k 1e-9) (results of k >= 1 in\n"
     "  DIR/pair_k/): the median and range over the pairs, and the reference's own spread; for runs\n"
     "  whose outcome is a draw (contacts, breakage; docs/decisions.md#d44)\n";
 

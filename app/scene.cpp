@@ -153,8 +153,6 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
       time->fail("dt", "the scene has no bond or contact stiffness, so dt: auto has no limit to scale; give dt in s");
     scene.dt = scene.safety * scene.dt_critical;
   }
-  // Only ever smaller (an ensemble's perturbation), so a step under the limit stays under it.
-  if (!static_only) scene.dt *= std::min(options.time_step_scale, 1.0);
   if (scene.end_time < 1e-9 * scene.dt) {
     std::ostringstream msg;
     msg << "time.end = " << scene.end_time << " s is not even 1e-9 of a time step (dt = " << scene.dt << " s): no step would run";
@@ -164,6 +162,9 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   // the scene far past time.end (750 times, a calibration placeholder's soft bonds).
   if (scene.dt > scene.end_time) scene.dt = scene.end_time;
   const double steps = std::ceil(scene.end_time / scene.dt - 1e-9);
+  // An ensemble's perturbation: only ever smaller, so a step under the limit stays under it; the
+  // steps are counted before it, so that a pair's run ends within 1e-9 of time.end, not a step past.
+  if (!static_only) scene.dt *= std::min(options.time_step_scale, 1.0);
   if (steps > 1e15) {
     std::ostringstream msg;
     msg << "time.end / dt = " << steps << " steps (time.end " << scene.end_time << " s, dt " << scene.dt

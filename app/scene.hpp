@@ -126,7 +126,7 @@ struct SceneOptions {
   bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
   bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
   StepProfile* profile = nullptr;      // --profile: runs time their step's phases into it
-  double time_step_scale = 1.0;        // dt (auto or given) times this: compare --ensemble's perturbation
+  double time_step_scale = 1.0;        // dt (auto or given) times this, at most 1: compare --ensemble's perturbation
 };
 
 // The options of `arlequin check` (and of the fuzz targets, which read as it does): those given,

@@ -233,6 +233,7 @@ def test_unknown_format_exits_2(results):
     '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "style": "bars"}]}]}',
     '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "colour": -1}]}]}',
     '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "colour": "C0"}]}]}',
+    '{"plots": [{"file": "a.png", "series": [{"x_values": [1], "y_values": [1], "colour": true}]}]}',
 ])
 def test_bad_plots_json_exits_2_with_one_line(results, text):
     (results.path / "plots.json").write_text(text)

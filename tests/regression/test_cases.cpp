@@ -975,7 +975,9 @@ TEST(Cli, CompareBoundsTheCoupledErrorAndHonoursChecks) {
 // The wave bar is linear, not chaotic: the perturbation moves its runs in proportion to it (the
 // reference's own spread 1.3e-9 and 2.5e-9 of the probe's largest value for pairs 1 and 2,
 // bounded at 1e-8; zero would mean no perturbation), every pair then tells the same (to 4e-8 of
-// the difference, bounded at 2e-7), and the figure reported is the median over the pairs.
+// the difference, bounded at 2e-7), and the figure reported is the median over the pairs; a
+// figure no pair has (a first break) is null per pair and has no median; each model's runs are
+// drawn in one colour.
 TEST(Cli, CompareEnsembleReportsTheMedianAndTheReferencesOwnSpread) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
@@ -1002,7 +1004,19 @@ TEST(Cli, CompareEnsembleReportsTheMedianAndTheReferencesOwnSpread) {
   for (double p : pairs) EXPECT_NEAR(p, pairs[0], 2e-7 * pairs[0]);
   std::sort(pairs.begin(), pairs.end());
   EXPECT_EQ(probe.at("max_relative_difference").get<double>(), pairs[1]);
-  EXPECT_NE(r.output.find("reference's own spread"), std::string::npos) << r.output;
+  // No break in a bar: each pair's first break is null, and no median is made up.
+  const Json& ensemble = c.at("ensemble");
+  EXPECT_EQ(ensemble.at("first_break_relative_difference_pairs"), Json::parse("[null, null, null]"));
+  EXPECT_FALSE(ensemble.contains("first_break_relative_difference"));
+  EXPECT_EQ(ensemble.at("speedup_compute_pairs").size(), 3u);
+  // Each sensor's plot: the three pairs' runs, each model's in one colour.
+  for (const Json& plot : read_json_file(out / "plots.json").at("plots")) {
+    std::vector<int> colours;
+    for (const Json& series : plot.at("series")) colours.push_back(series.at("colour").get<int>());
+    EXPECT_EQ(colours, (std::vector<int>{0, 1, 0, 1, 0, 1})) << plot.at("file");
+  }
+  EXPECT_NE(test::read_text(out / "compare.csv").find(",reference_spread_max_relative,"), std::string::npos);
+  EXPECT_NE(r.output.find("wave_bar_coupled (pair 0): 775 DEs"), std::string::npos) << r.output;
 }
 
 // case.resolved.yaml (also what `arlequin check` prints) is a case file: read back, it resolves

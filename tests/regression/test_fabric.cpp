@@ -304,10 +304,7 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
       EXPECT_LT(std::abs(sensor.at("peak_relative_difference").get<double>()), 0.10);
     }
   }
-  std::vector<double> first_breaks = report.at("ensemble").at("first_break_relative_difference").get<std::vector<double>>();
-  ASSERT_EQ(first_breaks.size(), 7u);
-  std::sort(first_breaks.begin(), first_breaks.end());
-  EXPECT_LT(std::abs(first_breaks[3]), 0.10);
+  EXPECT_LT(std::abs(report.at("ensemble").at("first_break_relative_difference").get<double>()), 0.10);
 
   const auto unbreakable = test::scratch_dir("fabric_coupled_seed_unbreakable");
   const auto u = test::run_arlequin("run " + coupled_dir + "case.yaml --set dem.sample.yarn.failure_strain=0 --set output.fields=[] --out " +
