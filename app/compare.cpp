@@ -16,6 +16,7 @@
 #include "common/error.hpp"
 #include "common/json.hpp"
 #include "common/plots.hpp"
+#include "common/statistics.hpp"
 
 namespace arlequin::app {
 namespace {
@@ -158,12 +159,6 @@ Difference difference(const Run& a, const Run& b, const std::string& name) {
 std::optional<double> first_break_difference(const Run& a, const Run& b) {
   if (!a.first_break || !b.first_break) return std::nullopt;
   return (*b.first_break - *a.first_break) / *a.first_break;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // A figure of the pairs: the value of one pair, or the median and the range of several; in %.

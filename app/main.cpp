@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -150,6 +151,14 @@ Arguments parse(int argc, char** argv) {
       if (k + 1 >= args.size()) throw InputError(arg + ": expected " + what + " after it");
       return args[++k];
     };
+    // The value after arg as a whole number in [lo, hi]; `expected` says so in the error.
+    const auto whole_number = [&](const char* what, long lo, long hi, const std::string& expected) {
+      const std::string v = value(what);
+      char* end = nullptr;
+      const long n = std::strtol(v.c_str(), &end, 10);
+      if (*end != '\0' || n < lo || n > hi) throw InputError(arg + ": expected " + expected + ", got '" + v + "'");
+      return n;
+    };
     if (arg == "--help" || arg == "-h") {
       a.help = true;
     } else if (arg == "--set") {
@@ -164,16 +173,9 @@ Arguments parse(int argc, char** argv) {
     } else if (arg == "--out" && (a.command == "run" || a.command == "sweep" || a.command == "compare" || a.command == "virtual-test" || a.command == "calibrate")) {
       a.scene.out_dir = value("a directory");
     } else if (arg == "--steps" && a.command == "run") {
-      const std::string v = value("a number of steps");
-      char* end = nullptr;
-      a.steps = std::strtol(v.c_str(), &end, 10);
-      if (*end != '\0' || a.steps < 0) throw InputError("--steps: expected a whole number >= 0, got '" + v + "'");
+      a.steps = whole_number("a number of steps", 0, std::numeric_limits<long>::max(), "a whole number >= 0");
     } else if (arg == "--ensemble" && a.command == "compare") {
-      const std::string v = value("a number of pairs");
-      char* end = nullptr;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (*end != '\0' || n < 1 || n > 1000) throw InputError("--ensemble: expected a whole number of pairs from 1 to 1000, got '" + v + "'");
-      a.ensemble = int(n);
+      a.ensemble = int(whole_number("a number of pairs", 1, 1000, "a whole number of pairs from 1 to 1000"));
     } else if (arg == "--restart" && a.command == "run") {
       a.restart = value("a checkpoint file");
     } else if (arg == "--of" && a.command == "schema") {

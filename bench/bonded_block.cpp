@@ -36,6 +36,7 @@
 #include "app/scene.hpp"
 #include "app/virtual_tests.hpp"
 #include "common/error.hpp"
+#include "common/statistics.hpp"
 #include "common/step_profile.hpp"
 #include "dem/bonds/beam_bond.hpp"
 
@@ -241,12 +242,6 @@ Timing run_virtual_test(const Options& o, int threads, arlequin::StepProfile& pr
   return {run, double(steps), "steps/s"};
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -288,10 +283,10 @@ int main(int argc, char** argv) try {
       rates[threads].push_back(t.work / t.seconds);
       unit = t.unit;
     }
-  const double one = median(rates[1]);
+  const double one = arlequin::median(rates[1]);
   std::printf("median of %d run(s) per thread count, alternated:\n", o.repeat);
   for (const auto& [threads, list] : rates)
-    std::printf("  threads %2d: %s %.3e  speed-up vs 1 thread %.2fx\n", threads, unit, median(list), median(list) / one);
+    std::printf("  threads %2d: %s %.3e  speed-up vs 1 thread %.2fx\n", threads, unit, arlequin::median(list), arlequin::median(list) / one);
   if (o.profile) {
     for (const auto& [threads, profile] : profiles) {
       if (threads == 1) std::printf("\n%s", profile.table().c_str());
