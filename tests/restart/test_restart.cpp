@@ -131,13 +131,18 @@ fs::path lattice_checkpoint(const std::string& name) {
   return out / "checkpoint.h5";
 }
 
-// Runs the lattice bar with `args` (split at spaces, no quoting) and sends `signal` after a
-// second; returns the wait status. Started directly: a shell's background job ignores SIGINT.
-int run_and_signal(const std::string& args, int signal) {
+// Runs the lattice bar with `args` (split at spaces, no quoting) writing to `out`, and sends
+// `signal` once the run is inside its time loop: when series.csv first appears (the series is
+// first written 2 s into the run, from the loop), not after a fixed delay, which a loaded machine
+// can spend starting the process. Returns the wait status. Started directly: a shell's background
+// job ignores SIGINT.
+int run_and_signal(const std::string& args, const fs::path& out, int signal) {
   const std::string exe = std::string(ARLEQUIN_BINARY_DIR) + "/app/arlequin";
   std::vector<std::string> words = {exe, "run", lattice, "--quiet"};
   std::istringstream in(args);
   for (std::string word; in >> word;) words.push_back(word);
+  words.push_back("--out");
+  words.push_back(out.string());
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
@@ -149,7 +154,8 @@ int run_and_signal(const std::string& args, int signal) {
     execv(exe.c_str(), argv.data());
     _exit(127);
   }
-  sleep(1);
+  // The run lasts several seconds on a quiet machine; a minute bounds the wait if it never loops.
+  for (int waited_ms = 0; !fs::exists(out / "series.csv") && waited_ms < 60000; waited_ms += 20) usleep(20000);
   kill(pid, signal);
   int status = 0;
   waitpid(pid, &status, 0);
@@ -158,9 +164,9 @@ int run_and_signal(const std::string& args, int signal) {
 
 TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
   const fs::path out = test::scratch_dir("restart_sigint"), stopped = out / "stopped", whole = out / "whole";
-  // Ten times the case's time: a run of several seconds, stopped after one; no checkpoint_every.
+  // Ten times the case's time: a run of several seconds, stopped inside its loop; no checkpoint_every.
   const std::string run = "run " + lattice + " --quiet --set time.end=3.0e-3";
-  const int status = run_and_signal(" --set time.end=3.0e-3 --out " + stopped.string(), SIGINT);
+  const int status = run_and_signal(" --set time.end=3.0e-3", stopped, SIGINT);
   ASSERT_TRUE(WIFEXITED(status));
   ASSERT_EQ(WEXITSTATUS(status), 130) << "the exit status after SIGINT: 128 + 2";
   const Json summary = Json::parse(test::read_text(stopped / "summary.json"));
@@ -183,7 +189,7 @@ TEST(RestartSignal, CtrlCLeavesACheckpointThatContinuesAsTheUninterruptedRun) {
 TEST(RestartSignal, KilledRunRestartsFromItsLastCheckpointWithItsFrames) {
   const fs::path out = test::scratch_dir("restart_sigkill"), killed = out / "killed", whole = out / "whole";
   const std::string settings = " --set time.end=3.0e-3 --set output.checkpoint_every=2.0e-5 --set output.fields_every=1.0e-5";
-  const int status = run_and_signal(settings + " --out " + killed.string(), SIGKILL);
+  const int status = run_and_signal(settings, killed, SIGKILL);
   ASSERT_TRUE(WIFSIGNALED(status));
   ASSERT_TRUE(fs::exists(killed / "checkpoint.h5"));
   ASSERT_FALSE(fs::exists(killed / "fields.h5"));
