@@ -346,10 +346,9 @@ const PhysicalGroup& Mesh::group(const std::string& name) const {
 }
 
 std::vector<std::array<int, 3>> Mesh::boundary_triangles() const {
-  static constexpr int kFaces[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};  // outward for V > 0
   std::map<std::array<int, 3>, std::pair<std::array<int, 3>, int>> count;
   for (int e = 0; e < num_tets(); ++e)
-    for (const auto& f : kFaces) {
+    for (const auto& f : kTetFaces) {
       std::array<int, 3> tri{tet(e)[f[0]], tet(e)[f[1]], tet(e)[f[2]]};
       std::array<int, 3> key = tri;
       std::sort(key.begin(), key.end());

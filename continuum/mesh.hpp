@@ -31,6 +31,9 @@ struct MeshSource {
 
 // Edge k of a tetrahedron joins vertices kTetEdges[k]; node 4+k of a P2 tetrahedron sits on it.
 inline constexpr std::array<std::array<int, 2>, 6> kTetEdges{{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+// Face k of a tetrahedron is the triangle of vertices kTetFaces[k], turning counter-clockwise
+// about its outward normal when the tetrahedron's volume is positive (as Mesh stores them).
+inline constexpr std::array<std::array<int, 3>, 4> kTetFaces{{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 
 struct PhysicalGroup {
   std::string name;

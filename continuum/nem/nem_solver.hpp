@@ -49,13 +49,17 @@
 //   the mesh boundary triangle that holds it), so loads and smoothed gradients satisfy the same
 //   integration constraint and the traction (Neumann) patch test is passed exactly.
 // - Lumped mass m_i = alpha(x_i) rho |V_i|.
-// Supported domains: one or more convex bodies. A body is a connected set of tetrahedra (joined
-// through shared nodes); bodies share no node (e.g. the two arms of the coupled DCB, meshed
-// apart). Each body is tessellated alone and must be a convex polyhedron (its boundary the convex
-// hull of its nodes; otherwise InputError); its nodes' cells, shape functions and gradients see
-// only its own nodes, and a point takes the shape functions of the first body that holds it (on
-// a face two bodies share, the first body's). See continuum/README.md for what a constrained
-// (non-convex) version needs.
+// Supported domains: one or more bodies, each a connected set of tetrahedra (joined through
+// shared nodes); bodies share no node (e.g. the two arms of the coupled DCB, meshed apart). A
+// convex body (its boundary the convex hull of its nodes) is tessellated alone; its nodes' cells,
+// shape functions and gradients see only its own nodes. A body that is not convex is cut into
+// convex pieces by the planes of its boundary faces (docs/decisions.md#d45; a tetrahedron one of
+// them cuts is an InputError): each piece is tessellated alone, neighbouring pieces share the
+// nodes of the face between them, where both give the 2D coordinates of the face's nodes, and the
+// fluxes through that face are integrated on the overlay of the two pieces' cells there, so
+// that they cancel between the pieces and the patch tests hold. A point takes the shape functions
+// of the first piece holding it. See continuum/README.md for what a constrained version (curved
+// re-entrant boundaries, cracks) needs.
 #pragma once
 #include <memory>
 

@@ -3,6 +3,7 @@
 
 #include <random>
 
+#include "common/error.hpp"
 #include "continuum/nem/nem_solver.hpp"
 #include "convergence_util.hpp"
 
@@ -132,6 +133,57 @@ TEST(ContinuumNem, TwoBodiesAreTessellatedApart) {
   const PatchErrors e = patch_test(*s, mat, false);
   EXPECT_LT(e.displacement, 1e-10);
   EXPECT_LT(e.stress, 1e-10);
+}
+
+// A body that is not convex (meshes/l_block.geo: an L of two unit cubes and a 0.1-thin slab,
+// its mesh with faces on the planes between them) is cut into its three boxes, which share the
+// nodes of those faces. Its shape functions are a partition of unity and reproduce linear fields
+// everywhere (on the shared faces too), the cells fill it (volume 2.1), and both patch tests hold
+// on it. The thin slab's far face is meshed apart from the face it shares with the cube, so its
+// nodes lie nearer that face than the face's own nodes and the two pieces' cells there differ:
+// only the overlay of the two sides' triangles (SharedFaceFluxes) makes the fluxes cancel (with
+// each side's own midpoint rule the Dirichlet patch test failed by some 1e-3 of the field). The
+// same L fused into one volume, with no faces on those planes, cannot be cut and is refused.
+TEST(ContinuumNem, NonConvexBodyIsCutIntoConvexPiecesThatShareFaces) {
+  const Material mat = Material::isotropic(1e3, 0.3, 1.0);
+  for (const auto& [shape, a] : {std::pair{"sibson", 1.0}, {"laplace", 1.0}, {"sibson", 4.0}}) {
+    ContinuumSettings s = settings("l_block.geo", 0.3, 1, mat);
+    s.shape_functions = shape;
+    s.nem_stabilization = a;
+    NemSolver solver(s);
+    double v = 0;
+    for (double vi : solver.cell_volumes()) v += vi;
+    EXPECT_NEAR(v, 2.1, 1e-12) << shape;
+    std::vector<Vec3> pts;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> uni(0, 1);
+    while (pts.size() < 300) {
+      const Vec3 p{1.1 * uni(rng), 2 * uni(rng), uni(rng)};
+      if (p.x < 1 || p.y < 1) pts.push_back(p);
+    }
+    for (double t = 0.05; t < 1; t += 0.1) pts.push_back({1.0, t, 0.5 * t}), pts.push_back({t, 1.0, 1 - t});  // shared faces
+    const InterpolationOperator N = solver.interpolation(pts);
+    for (size_t p = 0; p < pts.size(); ++p) {
+      double sum = 0;
+      Vec3 x{};
+      for (InterpolationOperator::InnerIterator it(N, p); it; ++it) sum += it.value(), x += it.value() * solver.nodes()[it.col()];
+      EXPECT_NEAR(sum, 1.0, 1e-12) << shape << " point " << p;
+      EXPECT_LT(norm(x - pts[p]), 1e-12) << shape << " point " << p;
+    }
+    for (bool traction : {false, true}) {
+      NemSolver fresh(s);
+      const PatchErrors e = patch_test(fresh, mat, traction);
+      EXPECT_LT(e.displacement, 1e-10) << shape << " a " << a << (traction ? " traction" : "");
+      EXPECT_LT(e.stress, 1e-10) << shape << " a " << a << (traction ? " traction" : "");
+    }
+  }
+  try {
+    NemSolver fused(settings("l_block_fused.geo", 0.3, 1, mat));
+    FAIL() << "the fused L was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not convex and the plane of one of its boundary faces cuts tetrahedron"), std::string::npos)
+        << e.what();
+  }
 }
 
 // Dirichlet and traction (Neumann) patch tests; the latter needs tractions integrated with the
