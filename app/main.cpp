@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -154,9 +155,11 @@ Arguments parse(int argc, char** argv) {
     // The value after arg as a whole number in [lo, hi]; `expected` says so in the error.
     const auto whole_number = [&](const char* what, long lo, long hi, const std::string& expected) {
       const std::string v = value(what);
-      char* end = nullptr;
-      const long n = std::strtol(v.c_str(), &end, 10);
-      if (*end != '\0' || n < lo || n > hi) throw InputError(arg + ": expected " + expected + ", got '" + v + "'");
+      long n = 0;
+      // from_chars takes the whole text or fails: no empty string, spaces or overflow read as a number.
+      const auto [end, error] = std::from_chars(v.data(), v.data() + v.size(), n);
+      if (v.empty() || error != std::errc() || end != v.data() + v.size() || n < lo || n > hi)
+        throw InputError(arg + ": expected " + expected + ", got '" + v + "'");
       return n;
     };
     if (arg == "--help" || arg == "-h") {

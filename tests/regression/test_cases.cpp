@@ -180,6 +180,17 @@ TEST(Cli, CompareAndSweepRefuseBadInputBeforeAnyRun) {
   EXPECT_NE(r.output.find("--over dem.damping=abc: dem.damping: expected a number"), std::string::npos) << r.output;
 }
 
+// --steps takes a whole number >= 0 and nothing else: an empty value, spaces, a sign, a fraction
+// or a number past a long are refused in one line, exit 2, before any run.
+TEST(BadInput, StepsThatAreNotAWholeNumber) {
+  for (const std::string bad : {"", " 5", "-1", "2.5", "5x", "99999999999999999999"}) {
+    const auto r = test::run_arlequin("run " + cases + "cantilever_chain/case.yaml --quiet --steps '" + bad + "' --out " +
+                                      test::scratch_path("steps_bad").string());
+    EXPECT_EQ(r.exit_code, 2) << "'" << bad << "': " << r.output;
+    EXPECT_NE(r.output.find("--steps: expected a whole number >= 0, got '" + bad + "'"), std::string::npos) << r.output;
+  }
+}
+
 // --out must name a folder that can be written: refused before the run, as bad input. `check`
 // writes nothing and does not judge it.
 TEST(BadInput, OutputFolderThatIsAFile) {
