@@ -23,7 +23,6 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     const size_t lanes = points.size(), m = static_cast<size_t>(key.first);
     b.dof.resize(m * lanes);
     b.gx.resize(m * lanes), b.gy.resize(m * lanes), b.gz.resize(m * lanes);
-    b.force.resize(3 * m * lanes);
     for (size_t i = 0; i < lanes; ++i)
       for (size_t k = 0; k < m; ++k) {
         const int e = offset[points[i]] + static_cast<int>(k);
@@ -32,35 +31,34 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
       }
     batches_.push_back(std::move(b));
   }
-  // Tiles, and each node's entries in the serial scatter's order (batch, lane, entry).
+  // Tiles, and each entry's slot: node by node, each node's entries in the serial scatter's
+  // order (batch, lane, entry).
   int nodes = 0;
   for (int n : node) nodes = std::max(nodes, n + 1);
-  gather_start_.assign(static_cast<size_t>(nodes) + 1, 0);
+  slot_start_.assign(static_cast<size_t>(nodes) + 1, 0);
   for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
     const Batch& b = batches_[static_cast<size_t>(bi)];
     const int lanes = static_cast<int>(b.point.size());
     for (int first = 0; first < lanes; first += kTile) tiles_.emplace_back(bi, first);
-    for (int d : b.dof) ++gather_start_[static_cast<size_t>(d / 3) + 1];
+    for (int d : b.dof) ++slot_start_[static_cast<size_t>(d / 3) + 1];
     entries_ += static_cast<long>(b.dof.size());
   }
-  for (int n = 0; n < nodes; ++n) gather_start_[static_cast<size_t>(n) + 1] += gather_start_[static_cast<size_t>(n)];
-  gather_.resize(static_cast<size_t>(gather_start_.back()));
-  std::vector<int> next(gather_start_.begin(), gather_start_.end() - 1);
-  for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
-    const Batch& b = batches_[static_cast<size_t>(bi)];
-    const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
-    for (int i = 0; i < lanes; ++i)
-      for (int k = 0; k < m; ++k)
-        gather_[static_cast<size_t>(next[static_cast<size_t>(b.dof[static_cast<size_t>(k) * lanes + i] / 3)]++)] = {
-            bi, 3 * k * lanes + i};
+  for (int n = 0; n < nodes; ++n) slot_start_[static_cast<size_t>(n) + 1] += slot_start_[static_cast<size_t>(n)];
+  std::vector<int> next(slot_start_.begin(), slot_start_.end() - 1);
+  for (Batch& b : batches_) {
+    const size_t lanes = b.point.size(), m = static_cast<size_t>(b.nodes_per_point);
+    b.slot.resize(m * lanes);
+    for (size_t i = 0; i < lanes; ++i)
+      for (size_t k = 0; k < m; ++k) b.slot[k * lanes + i] = next[static_cast<size_t>(b.dof[k * lanes + i] / 3)]++;
   }
+  slot_force_.resize(3 * static_cast<size_t>(entries_));
 }
 
 // Lanes [first, first + count) of a batch, in three passes that each vectorise across lanes
 // for any node count: H = sum_k u_k (x) grad N_k, entry by entry; then per lane the
 // Green-Lagrange strain in Voigt order (xx, yy, zz, yz, xz, xy; engineering shears 2 E_ij = H_ij +
 // H_ji + sum_k H_ki H_kj), S = C E and w P = w F S; then each entry's w P grad N.
-void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const double* u, const double* w) {
+void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const double* u, const double* w, double* slots) {
   const int lanes = static_cast<int>(b.point.size()), m = b.nodes_per_point;
   double c[6][6];
   for (int r = 0; r < 6; ++r)
@@ -106,16 +104,16 @@ void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const 
     p[7][t] = wq * (h20 * s[5] + h21 * s[1] + (1 + h22) * s[3]);
     p[8][t] = wq * (h20 * s[4] + h21 * s[3] + (1 + h22) * s[2]);
   }
-  double* force = b.force.data();
   for (int k = 0; k < m; ++k) {
     const size_t e0 = static_cast<size_t>(k) * lanes + first;
     const double *gx = b.gx.data() + e0, *gy = b.gy.data() + e0, *gz = b.gz.data() + e0;
-    double *fx = force + static_cast<size_t>(3 * k) * lanes + first, *fy = fx + lanes, *fz = fy + lanes;
+    const int* slot = b.slot.data() + e0;
 #pragma omp simd
     for (int t = 0; t < count; ++t) {
-      fx[t] = p[0][t] * gx[t] + p[1][t] * gy[t] + p[2][t] * gz[t];
-      fy[t] = p[3][t] * gx[t] + p[4][t] * gy[t] + p[5][t] * gz[t];
-      fz[t] = p[6][t] * gx[t] + p[7][t] * gy[t] + p[8][t] * gz[t];
+      double* f = slots + 3 * static_cast<size_t>(slot[t]);
+      f[0] = p[0][t] * gx[t] + p[1][t] * gy[t] + p[2][t] * gz[t];
+      f[1] = p[3][t] * gx[t] + p[4][t] * gy[t] + p[5][t] * gz[t];
+      f[2] = p[6][t] * gx[t] + p[7][t] * gy[t] + p[8][t] * gz[t];
     }
   }
 }
@@ -123,25 +121,20 @@ void FiniteStrainForce::tile_forces(const Batch& b, int first, int count, const 
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
-  const long nodes = static_cast<long>(gather_start_.size()) - 1;
+  const long nodes = static_cast<long>(slot_start_.size()) - 1;
+  double* slots = slot_force_.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
 #pragma omp for schedule(static)
     for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
       const auto [bi, first] = tiles_[static_cast<size_t>(t)];
       const Batch& b = batches_[static_cast<size_t>(bi)];
-      tile_forces(b, first, std::min(kTile, static_cast<int>(b.point.size()) - first), u.data(), w.data());
+      tile_forces(b, first, std::min(kTile, static_cast<int>(b.point.size()) - first), u.data(), w.data(), slots);
     }
 #pragma omp for schedule(static)
     for (long n = 0; n < nodes; ++n) {
       double f[3] = {0.0, 0.0, 0.0};
-      for (int g = gather_start_[static_cast<size_t>(n)]; g < gather_start_[static_cast<size_t>(n) + 1]; ++g) {
-        const auto [bi, at] = gather_[static_cast<size_t>(g)];
-        const Batch& b = batches_[static_cast<size_t>(bi)];
-        const size_t lanes = b.point.size();
-        f[0] += b.force[static_cast<size_t>(at)];
-        f[1] += b.force[static_cast<size_t>(at) + lanes];
-        f[2] += b.force[static_cast<size_t>(at) + 2 * lanes];
-      }
+      for (int s = slot_start_[static_cast<size_t>(n)]; s < slot_start_[static_cast<size_t>(n) + 1]; ++s)
+        for (int c = 0; c < 3; ++c) f[c] += slots[3 * static_cast<size_t>(s) + c];
       for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
     }
   });

@@ -13,9 +13,10 @@
 //    and stored lane-major (entry k of lane i at k * lanes + i), so that passes over a tile of
 //    lanes compute H, E, S and P of many points at once, vectorised for any node count. The
 //    tiles run on the OpenMP threads (above parallel_threshold entries), each writing its own
-//    lanes' node forces; then every node sums its entries in one fixed order (batch, lane,
-//    entry: the order of a serial scatter), the nodes split over the threads: the same bits
-//    on any thread count.
+//    entries' node forces into the entry's slot of one array ordered by node (each node's
+//    entries in the order of a serial scatter: batch, lane, entry); then every node sums its
+//    slots, a contiguous run, in that order, the nodes split over the threads: the same bits on
+//    any thread count, and the sum reads memory in sequence rather than an entry here and there.
 #pragma once
 #include <utility>
 #include <vector>
@@ -36,20 +37,20 @@ class FiniteStrainForce {
   struct Batch {
     int nodes_per_point = 0;  // m
     Stiffness C;
-    std::vector<int> point;             // q of each lane
-    std::vector<int> dof;               // [k * lanes + i]: 3 x node of entry k of lane i
-    std::vector<double> gx, gy, gz;     // [k * lanes + i]
-    mutable std::vector<double> force;  // [(3 k + c) * lanes + i]: w_q (P_q grad N_k)_c of lane i
+    std::vector<int> point;          // q of each lane
+    std::vector<int> dof;            // [k * lanes + i]: 3 x node of entry k of lane i
+    std::vector<double> gx, gy, gz;  // [k * lanes + i]
+    std::vector<int> slot;           // [k * lanes + i]: where entry k of lane i puts its force
   };
   // Lanes are computed a tile at a time (the tile's H and P stay in registers and cache).
   static constexpr int kTile = 256;
-  static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w);
+  static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w, double* slots);
   std::vector<Batch> batches_;
   std::vector<std::pair<int, int>> tiles_;  // (batch, first lane) of every tile
-  // Node n's entries: gather_[gather_start_[n] .. gather_start_[n + 1]), each (batch, offset of
-  // its x component in the batch's force; y and z follow at + lanes, + 2 lanes).
-  std::vector<int> gather_start_;
-  std::vector<std::pair<int, int>> gather_;
+  // Every entry's force w_q P_q grad N_k (3 values) in its slot; node n's slots are
+  // slot_start_[n] .. slot_start_[n + 1].
+  std::vector<int> slot_start_;
+  mutable std::vector<double> slot_force_;
   long entries_ = 0;
 };
 
