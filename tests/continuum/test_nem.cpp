@@ -177,6 +177,15 @@ TEST(ContinuumNem, NonConvexBodyIsCutIntoConvexPiecesThatShareFaces) {
       EXPECT_LT(e.stress, 1e-10) << shape << " a " << a << (traction ? " traction" : "");
     }
   }
+  // A node on a face two pieces of different densities share takes its cell in each at that
+  // piece's density: the lumped masses add up to the three boxes' masses.
+  ContinuumSettings layered = settings("l_block.geo", 0.3, 1, mat);
+  layered.materials = {{"cube", Material::isotropic(1e3, 0.3, 1.0)}, {"slab", Material::isotropic(1e3, 0.3, 2.0)},
+                       {"arm", Material::isotropic(1e3, 0.3, 3.0)}};
+  const NemSolver layered_solver(layered);
+  double mass = 0;
+  for (double m : layered_solver.lumped_mass()) mass += m;
+  EXPECT_NEAR(mass, 1.0 * 1.0 + 2.0 * 0.1 + 3.0 * 1.0, 1e-12);
   try {
     NemSolver fused(settings("l_block_fused.geo", 0.3, 1, mat));
     FAIL() << "the fused L was accepted";
