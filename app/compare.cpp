@@ -190,19 +190,20 @@ Json numbers(const std::vector<double>& v) {
 }  // namespace
 
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
-                           const SceneOptions& base, const std::filesystem::path& out_dir, int ensemble) {
+                           const SceneOptions& reference, const SceneOptions& other, const std::filesystem::path& out_dir,
+                           int ensemble) {
   std::error_code ec;
   if (std::filesystem::equivalent(reference_case, other_case, ec))
     std::fprintf(stderr, "arlequin compare: warning: both runs are %s; the differences are run-to-run noise\n",
                  reference_case.string().c_str());
   const auto pair_dir = [&](int k) { return k == 0 ? out_dir : out_dir / ("pair_" + std::to_string(k)); };
-  const auto pair_options = [&](int k) {
-    SceneOptions options = base;
+  const auto pair_options = [&](const SceneOptions& side, int k) {
+    SceneOptions options = side;
     options.time_step_scale = 1.0 - k * ensemble_time_step_perturbation;
     return options;
   };
-  Prepared prepared_a = prepare(reference_case, pair_options(0), out_dir / "reference");
-  Prepared prepared_b = prepare(other_case, pair_options(0), out_dir / "other");
+  Prepared prepared_a = prepare(reference_case, pair_options(reference, 0), out_dir / "reference");
+  Prepared prepared_b = prepare(other_case, pair_options(other, 0), out_dir / "other");
   // Shared sensor columns (the energy totals mean different things for a DEM and a coupled run).
   const std::vector<std::string> sensors_a = sensor_columns(*prepared_a.scene), sensors_b = sensor_columns(*prepared_b.scene);
   const std::vector<std::string> units_a = sensor_units(*prepared_a.scene);
@@ -223,10 +224,10 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       std::printf("pair %d of 0..%d: time steps x (1 - %d x %.0e)\n", k, ensemble - 1, k, ensemble_time_step_perturbation);
       std::fflush(stdout);  // before the runs' own lines
     }
-    if (k > 0) prepared_a = prepare(reference_case, pair_options(k), pair_dir(k) / "reference");
+    if (k > 0) prepared_a = prepare(reference_case, pair_options(reference, k), pair_dir(k) / "reference");
     reference_runs.push_back(execute(prepared_a, pair_dir(k) / "reference"));
     prepared_a.scene.reset();
-    if (k > 0) prepared_b = prepare(other_case, pair_options(k), pair_dir(k) / "other");
+    if (k > 0) prepared_b = prepare(other_case, pair_options(other, k), pair_dir(k) / "other");
     other_runs.push_back(execute(prepared_b, pair_dir(k) / "other"));
     prepared_b.scene.reset();
   }

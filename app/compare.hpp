@@ -40,6 +40,7 @@ inline constexpr double ensemble_time_step_perturbation = 1e-9;
 // of two static solves. With an ensemble, compare.json's "reference" and "other" and the runs'
 // printed sizes and energies are pair 0's; every difference and the speed-up are medians.
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
-                           const SceneOptions& base, const std::filesystem::path& out_dir, int ensemble = 1);
+                           const SceneOptions& reference, const SceneOptions& other, const std::filesystem::path& out_dir,
+                           int ensemble = 1);
 
 }  // namespace arlequin::app

@@ -191,6 +191,29 @@ TEST(BadInput, StepsThatAreNotAWholeNumber) {
   }
 }
 
+// compare's --set applies to both cases, --set-reference and --set-other to one, after it: each
+// run's resolved case has its own, and a key the other case cannot take is refused under its
+// option's name before any run (the pure DEM has no continuum to swap).
+TEST(Cli, CompareSetsEachCaseApart) {
+  const auto out = test::scratch_dir("compare_sides");
+  const std::string chain = cases + "cantilever_chain/case.yaml ";
+  auto r = test::run_arlequin("compare " + chain + chain + "--set time.end=2e-3 --set checks=[] --set dem.damping=300 --set-reference "
+                              "dem.damping=200 --set-other dem.damping=100 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto damping = [&](const char* side) {
+    const std::string text = test::read_text(out / side / "case.resolved.yaml");
+    const std::size_t at = text.find("damping: ");
+    return at == std::string::npos ? std::string() : text.substr(at + 9, text.find('\n', at) - at - 9);
+  };
+  EXPECT_EQ(damping("reference"), "200");
+  EXPECT_EQ(damping("other"), "100");
+  const auto bad_out = test::scratch_dir("compare_sides_bad");
+  r = test::run_arlequin("compare " + chain + chain + "--set-other continuum.solver=nem --out " + bad_out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--set-other continuum.solver=nem: continuum"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(bad_out / "reference" / "series.csv"));
+}
+
 // --out must name a folder that can be written: refused before the run, as bad input. `check`
 // writes nothing and does not judge it.
 TEST(BadInput, OutputFolderThatIsAFile) {
