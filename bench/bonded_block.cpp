@@ -198,14 +198,14 @@ void time_beam_kernel(const Options& o) {
     const double all = fastest([&] {
       for (std::size_t pass = 0; pass < passes; ++pass)
         for (std::size_t k = 0; k < blocks; ++k) {
-          beams->actions(k * block, block, particles, out);
+          beams->actions(k * block, block, particles, out, false);
           sink = out.force_on_j[0][0];
         }
     });
     const double one = fastest([&] {
       for (std::size_t pass = 0; pass < passes; ++pass)
         for (std::size_t k = 0; k < blocks; ++k) {
-          beams->actions(k % cached * block, block, particles, out);
+          beams->actions(k % cached * block, block, particles, out, false);
           sink = out.force_on_j[0][0];
         }
     });

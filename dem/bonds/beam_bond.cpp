@@ -5,13 +5,16 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
 #if defined(__AVX512F__)
-// GCC 12's _mm512_sqrt_pd starts from _mm512_undefined_pd: a false -Wuninitialized.
+// GCC 12's _mm512_sqrt_pd starts from _mm512_undefined_pd: a false -Wuninitialized (or
+// -Wmaybe-uninitialized, by where it is inlined).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <immintrin.h>
 #pragma GCC diagnostic pop
 #endif
@@ -229,7 +232,7 @@ void BeamBondSet::reorder(std::span<const std::uint32_t> order) {
 
 BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) const {
   ActionsBlock a;
-  actions(b, 1, p, a);
+  actions(b, 1, p, a, true);
   return a[0];
 }
 
@@ -237,7 +240,7 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
 // thread each compile) and single bonds, so FMA contraction cannot differ between them (the bits
 // of a bond's actions do not depend on who asks).
 [[gnu::noinline]] void BeamBondSet::actions(std::size_t first, std::size_t count, const ParticleSet& p,
-                                            ActionsBlock& out) const {
+                                            ActionsBlock& out, bool with_stresses) const {
   assert(count >= 1 && count <= lanes);
   // Lane l holds bond first + l; lanes past count repeat the last bond (out holds it there
   // again). The DEs' positions (as x, y, z, 0) and orientations are loaded whole, one vector a
@@ -294,6 +297,18 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
   store(out.length, length), store(out.axial_force, axial_force), store(out.twist, twist);
   store_vec(out.axis, axis), store_vec(out.theta_a, theta_a), store_vec(out.theta_b, theta_b);
   store_vec(out.force_on_j, force_on_j), store_vec(out.torque_on_i, torque_on_i), store_vec(out.torque_on_j, torque_on_j);
+  if (!with_stresses) {
+    const Lanes nan = Lanes{} + std::numeric_limits<double>::quiet_NaN();
+    store(out.axial_stress, nan), store(out.bending_stress, nan);
+    return;
+  }
+  // BBF (header): N / S = E (L - L0) / L0 and r_b |M| / I = 2 E r_b / L0 max(|2 theta_a + theta_b|,
+  // |theta_a + 2 theta_b|), with the nominal E.
+  const double young = parameters_.young;
+  const auto lane_norm = [](const LaneVec& v) { return lane_sqrt(dot(v, v)); };
+  const Lanes end_a = lane_norm(2.0 * theta_a + theta_b), end_b = lane_norm(theta_a + 2.0 * theta_b);
+  store(out.axial_stress, young * (length - rest_length) / rest_length);
+  store(out.bending_stress, 2.0 * young * load(beam_radius_) / rest_length * (end_a < end_b ? end_b : end_a));
 }
 
 void BeamBondSet::finalize(std::size_t n_particles) {
@@ -327,15 +342,21 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
     for (long first = 0; first < bonds; first += long(block)) {
       ActionsBlock a;
       const std::size_t count = std::min<std::size_t>(block, std::size_t(bonds - first));
-      actions(std::size_t(first), count, p, a);
+      actions(std::size_t(first), count, p, a, r.criterion);
       const double* from[9] = {a.force_on_j[0],  a.force_on_j[1],  a.force_on_j[2],  a.torque_on_i[0], a.torque_on_i[1],
                                a.torque_on_i[2], a.torque_on_j[0], a.torque_on_j[1], a.torque_on_j[2]};
       for (int c = 0; c < 9; ++c) std::memcpy(bond_actions_[c].data() + first, from[c], sizeof(ActionsBlock::Lane));
-      if (r.criterion || r.energy)
-        for (std::size_t l = 0; l < count; ++l) {
-          if (r.criterion) note_measure(first + l, failure_measure(first + l, a[l]));
-          if (r.energy) energy_record_[first + l] = energy_of(first + l, a[l]);
-        }
+      if (r.criterion) {  // failure_measure, lane by lane; the lanes at the strength one by one (rare)
+        Lanes axial_stress, bending_stress;
+        std::memcpy(&axial_stress, a.axial_stress, sizeof axial_stress);
+        std::memcpy(&bending_stress, a.bending_stress, sizeof bending_stress);
+        const Lanes measure = axial_stress + bending_stress;
+        std::memcpy(measure_.data() + first, &measure, count * sizeof(double));
+        if (!every_lane(measure < strength()))
+          for (std::size_t l = 0; l < count; ++l) note_measure(first + l, measure[l]);
+      }
+      if (r.energy)
+        for (std::size_t l = 0; l < count; ++l) energy_record_[first + l] = energy_of(first + l, a[l]);
     }
     // Every bonded DE adds its bonds' actions in bond order (-f on a first DE, +f on a second),
     // split over the threads in DE order as the kicks. Raw pointers: nothing in the loop can
@@ -374,15 +395,6 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
   });
 }
 
-double BeamBondSet::axial_stress(std::size_t b, const Actions& a) const {
-  return parameters_.young * (a.length - rest_length_[b]) / rest_length_[b];
-}
-
-double BeamBondSet::bending_stress(std::size_t b, const Actions& a) const {
-  return 2.0 * parameters_.young * beam_radius_[b] / rest_length_[b] *
-         std::max(norm(2.0 * a.theta_a + a.theta_b), norm(a.theta_a + 2.0 * a.theta_b));
-}
-
 double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
   const double stretch = a.length - rest_length_[b];
   return 0.5 * axial_[b] * stretch * stretch +
@@ -395,7 +407,7 @@ double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {
 FailureMode BeamBondSet::mode_of(std::size_t b, const Actions& a) const {
   const double E = parameters_.young, G = E / (2.0 * (1.0 + parameters_.poisson));
   const double L0 = rest_length_[b], rb = beam_radius_[b];
-  const double axial = axial_stress(b, a), bending = bending_stress(b, a);
+  const double axial = a.axial_stress, bending = a.bending_stress;
   const double shear = 1.5 * E * rb * rb * norm(a.theta_a + a.theta_b) / (L0 * L0);
   const double torsion = G * rb * std::abs(a.twist) / L0;
   FailureMode mode = axial >= 0.0 ? FailureMode::tension : FailureMode::compression;

@@ -68,6 +68,7 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
     double length, axial_force, twist;
     Vec3 axis, theta_a, theta_b;
     Vec3 force_on_j, torque_on_i, torque_on_j;  // force on i is -force_on_j
+    double axial_stress, bending_stress;        // BBF's N / S and r_b |M| / I at the more loaded end, Pa
   };
   Actions actions(std::size_t b, const ParticleSet& p) const;
   // Bonds are evaluated `block` at a time (one per SIMD lane), their actions kept as the
@@ -78,16 +79,19 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
     using Lane = double[block];
     Lane length, axial_force, twist;
     Lane axis[3], theta_a[3], theta_b[3], force_on_j[3], torque_on_i[3], torque_on_j[3];
+    Lane axial_stress, bending_stress;
     static Vec3 at(const Lane (&v)[3], std::size_t l) { return {v[0][l], v[1][l], v[2][l]}; }
     Actions operator[](std::size_t l) const {
       return {length[l],         axial_force[l],       twist[l],
               at(axis, l),       at(theta_a, l),       at(theta_b, l),
-              at(force_on_j, l), at(torque_on_i, l),   at(torque_on_j, l)};
+              at(force_on_j, l), at(torque_on_i, l),   at(torque_on_j, l),
+              axial_stress[l],   bending_stress[l]};
     }
   };
   // The actions of bonds [first, first + count), count in [1, block], into lanes [0, count)
-  // of out (the lanes past count hold the last bond's again).
-  void actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out) const;
+  // of out (the lanes past count hold the last bond's again); BBF's stresses only `with_stresses`
+  // (NaN otherwise: the force pass of an unbreakable set does not pay for them).
+  void actions(std::size_t first, std::size_t count, const ParticleSet& p, ActionsBlock& out, bool with_stresses) const;
   const Parameters& parameters() const { return parameters_; }
 
   // The law's kernel (BondKernelSet).
@@ -97,7 +101,7 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   static Vec3 torque_on_i(const Actions& a) { return a.torque_on_i; }
   static Vec3 torque_on_j(const Actions& a) { return a.torque_on_j; }
   double energy_of(std::size_t b, const Actions& a) const;
-  double failure_measure(std::size_t b, const Actions& a) const { return axial_stress(b, a) + bending_stress(b, a); }
+  double failure_measure(std::size_t, const Actions& a) const { return a.axial_stress + a.bending_stress; }
   FailureMode mode_of(std::size_t b, const Actions& a) const;
   double strength() const { return parameters_.strength; }
   void reorder(std::span<const std::uint32_t> order);
@@ -109,10 +113,6 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   void add_frequency_bound(std::size_t b, const ParticleSet& p, std::span<double> translational, std::span<double> rotational) const;
 
  private:
-  // BBF's normal stress terms (above), Pa: N / S, and r_b |M| / I at the more loaded end.
-  double axial_stress(std::size_t b, const Actions& a) const;
-  double bending_stress(std::size_t b, const Actions& a) const;
-
   Parameters parameters_;
   std::vector<double> rest_length_;   // L0, m
   std::vector<double> beam_radius_;   // r_b, m

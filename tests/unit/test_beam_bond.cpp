@@ -123,7 +123,8 @@ TEST_F(TwoDEs, EnergyIsThePotentialOfTheForces) {
 // Each lane has its own rest length and direction (in the xz-plane, so its reference normal
 // p0 is (-sin phi, 0, cos phi)), its own end rotation about p0, twist about the axis and
 // stretch, in the atan series (below 2.9 degrees), beyond it (atan2) or exactly zero, and gives
-// them back: the rotation, the twist, and the axial force E S / L0 times the stretch.
+// them back: the rotation, the twist, the axial force E S / L0 times the stretch, and BBF's
+// stresses (computed in the lanes too): E times the strain, and 2 E r_b / L0 times 2 |turn|.
 TEST(BeamBlock, EachLaneIsItsOwnBond) {
   const double turns[] = {0.0, 1e-9, 1e-6, 0.01, 0.049, 0.051, 0.2, 1.0, 2.5, -0.3, -1e-3};  // rad
   const double twists[] = {0.3, 0.0, -1e-3, 2.0, 1e-7, -0.04, 0.06, 0.0, 1e-5, -1.2, 0.5};  // rad
@@ -148,13 +149,15 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
     p.position[2 * k + 1] += direction(k) * stretch(k);
   }
   BeamBondSet::ActionsBlock blocks[2];
-  beam.actions(0, BeamBondSet::block, p, blocks[0]);
-  beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks[1]);
+  beam.actions(0, BeamBondSet::block, p, blocks[0], true);
+  beam.actions(BeamBondSet::block, n - BeamBondSet::block, p, blocks[1], true);
   for (std::size_t b = 0; b < n; ++b) {
     const BeamBondSet::Actions alone = beam.actions(b, p), a = blocks[b / BeamBondSet::block][b % BeamBondSet::block];
     EXPECT_EQ(a.length, alone.length) << b;
     EXPECT_EQ(a.axial_force, alone.axial_force) << b;
     EXPECT_EQ(a.twist, alone.twist) << b;
+    EXPECT_EQ(a.axial_stress, alone.axial_stress) << b;
+    EXPECT_EQ(a.bending_stress, alone.bending_stress) << b;
     for (const auto& [x, y] : {std::pair{a.axis, alone.axis}, {a.theta_a, alone.theta_a}, {a.theta_b, alone.theta_b},
                                {a.force_on_j, alone.force_on_j}, {a.torque_on_i, alone.torque_on_i},
                                {a.torque_on_j, alone.torque_on_j}})
@@ -166,6 +169,10 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
     EXPECT_LT(norm(a.theta_b), 1e-15) << b;
     EXPECT_NEAR(a.twist, twists[k], 5e-12 * std::abs(twists[k]) + 1e-15) << b;
     expect_relative(a.axial_force, R1Beam::E * R1Beam::S / rest_length(k) * stretch(k), 1e-9);
+    const double unit_strain = R1Beam::E * 1e-5;  // the stresses' scale: E times a strain of 1e-5
+    EXPECT_NEAR(a.axial_stress, R1Beam::E * stretch(k) / rest_length(k), 1e-9 * unit_strain) << b;
+    const double bending = 4.0 * R1Beam::E * R1Beam::r_mu * R1Beam::R / rest_length(k) * std::abs(turns[k]);
+    EXPECT_NEAR(a.bending_stress, bending, 5e-12 * bending + 1e-9 * unit_strain) << b;
   }
 }
 
