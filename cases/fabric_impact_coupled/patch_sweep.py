@@ -64,38 +64,20 @@ def main(argv):
         raise SystemExit(__doc__)
     pure = arlequin.load(Path(argv[1]))
     sweep_dir = Path(argv[2])
-    runs = [arlequin.load(p.parent) for p in sorted(sweep_dir.glob("*/summary.json"))]
-    if not runs:
-        raise SystemExit(f"{sweep_dir}: no run folder (with summary.json) in it")
-    runs.sort(key=lambda r: r.summary["counts"]["particles"])
+    runs = arlequin.load_sweep(sweep_dir)
     rows = [row_of(pure, pure, "pure DEM")] + [row_of(r, pure, patch_of(r)) for r in runs]
     header = ["DEM core", "DEs", "plate nodes", "wall [s]", "speed-up", "velocity: max rel.", "peak force", "first break",
               "fracture energy [J]", "max |E_balance| / E_0"]
-    print("| " + " | ".join(header) + " |")
-    print("|" + "---|" * len(header))
-    for r in rows:
-        print(f"| {r['run']} | {r['des']} | {r['nodes']} | {r['wall_s']:.1f} | {rows[0]['wall_s'] / r['wall_s']:.2f}x | "
-              f"{100 * r['velocity_max_rel']:.2f} % | {100 * r['peak_force_rel']:+.1f} % | {100 * r['first_break_rel']:+.1f} % | "
-              f"{r['fracture_J']:.4f} | {r['balance_rel']:.1e} |")
+    print(arlequin.markdown_table(header, [
+        [r["run"], r["des"], r["nodes"], f"{r['wall_s']:.1f}", f"{rows[0]['wall_s'] / r['wall_s']:.2f}x",
+         f"{100 * r['velocity_max_rel']:.2f} %", f"{100 * r['peak_force_rel']:+.1f} %", f"{100 * r['first_break_rel']:+.1f} %",
+         f"{r['fracture_J']:.4f}", f"{r['balance_rel']:.1e}"] for r in rows]))
     arlequin.write_table(sweep_dir / "patch_sweep.csv", rows)
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 4))
-    coupled = rows[1:]
-    ax.plot([r["wall_s"] for r in coupled], [100 * r["velocity_max_rel"] for r in coupled], "o-", label="coupled")
-    for r in coupled:
-        ax.annotate(f"{r['run']} ({r['des']} DEs)", (r["wall_s"], 100 * r["velocity_max_rel"]), fontsize=8)
-    ax.axvline(rows[0]["wall_s"], color="k", ls="--", label=f"pure DEM ({rows[0]['des']} DEs)")
-    ax.axhline(5.0, color="r", ls=":", label="5 %")
-    ax.set_xlabel("wall time of the run's time loop [s]")
-    ax.set_ylabel("sphere velocity: max |v / v_pure - 1| [%]")
-    ax.set_title("Coupled fabric impact against pure DEM, over the DEM patch")
-    ax.legend(fontsize=8)
-    ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(sweep_dir / "patch_sweep.png", dpi=120)
+    arlequin.plot_error_against_time(sweep_dir / "patch_sweep.png", rows[0], rows[1:],
+                                     [("coupled", "velocity_max_rel", "o-")],
+                                     "Coupled fabric impact against pure DEM, over the DEM patch",
+                                     "sphere velocity: max |v / v_pure - 1| [%]")
 
 
 if __name__ == "__main__":

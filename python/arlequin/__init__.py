@@ -7,5 +7,6 @@ is cheap: numpy, pandas, h5py and matplotlib are imported only when first needed
 """
 
 from .results import Run, load, write_table
+from .sweeps import load_sweep, markdown_table, plot_error_against_time
 
-__all__ = ["Run", "load", "write_table"]
+__all__ = ["Run", "load", "write_table", "load_sweep", "markdown_table", "plot_error_against_time"]
