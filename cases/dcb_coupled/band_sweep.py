@@ -11,6 +11,11 @@ overlap's width (cases/dcb_coupled/README.md): error against run time.
     PYTHONPATH=python python3 cases/dcb_coupled/band_sweep.py results/dcb_band_pure results/dcb_band_sweep
 
 (time.end = 2.1 ms: the load lines have opened by Delta = 2.0 mm, the end of the comparison.)
+These sweep the case itself (40k DEs). The README's table is at 20k (docs/decisions.md#d46): both
+commands also take --set dem.sample.radius.mean=1.75e-4 --set dem.sample.file=$PWD/results/dcb_band_20k.h5
+(one packing for all the runs: an absolute path, as a relative one is read from each case's own
+folder), the pure run the 20k load lines, --set "groups=$G" with G the third
+entry of cases/dcb/sweep_groups.txt, and the sweep --set coupling.continuum_substeps=3.
 For each run: the band (half-thickness and overlap width, from its resolved case), its DEs and the
 continuum's degrees of freedom, the time loop's wall time, and against the pure-DEM run: P(Delta)
 (the largest |P / P_pure - 1| over Delta in [0.5, 2.0] mm, P_pure interpolated at the run's
