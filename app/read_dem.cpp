@@ -56,6 +56,8 @@ constexpr KeyDoc sample_keys[] = {
     {"seed", KeyType::integer, "", Range::non_negative(), "1", "random seed of the packing"},
     {"bond_tolerance", KeyType::number, "1", Range::between(0, 0.5), "0.03", "gap, over the mean radius, that counts as contact in the packing"},
     {"file", KeyType::string, "", {}, "(results/<name>/sample.h5)", "where the packing is cached (HDF5), relative to the case"},
+    {"keep", KeyType::section, "", {}, "(every DE)",
+     "packing: only the DEs whose centre lies in this region are created (a piece of a specimen, e.g. for a virtual test; the cache holds the whole packing)"},
     {"size", KeyType::numbers, "m", Range::positive(), "", "weave: the fabric's extent [along x (weft), along y (warp)]"},
     {"weft_layers", KeyType::integer, "", Range::at_least(2), "3", "weave: layers of weft yarns"},
     {"weft_spacing", KeyType::number, "m", Range::positive(), "", "weave: centre distance of the weft columns (along y)"},
@@ -286,6 +288,14 @@ void read_sample(CaseNode sample, Scene& scene, double density, const SceneOptio
     read_weave(sample, scene);
   } else if (build == "packing") {
     read_packing(sample, scene, density, options);
+    // A piece of a specimen's packing, cut from the whole one, keeps the specimen's own surfaces
+    // and inner layers where a packing of the piece alone would have surfaces at its cuts.
+    if (auto keep = sample.child_if("keep")) {
+      const Region region = Region::read(*keep);
+      keep->finish();
+      p.keep_only([&](std::size_t i) { return region.contains(p.position[i]); });
+      if (p.size() == 0) sample.fail("keep", "no DE of the packing has its centre in this region");
+    }
   } else if (build == "lattice") {
     const Vec3 origin = sample.vec3_or("origin", {}, Range::any(), "m");
     const auto counts = sample.numbers("counts", Range::at_least(1), "1");

@@ -6,7 +6,16 @@ draws the plots that the C++ program describes in DIR/plots.json. Importing this
 is cheap: numpy, pandas, h5py and matplotlib are imported only when first needed.
 """
 
+from .beams import cantilever_bending_modulus
 from .results import Run, load, write_table
 from .sweeps import load_sweep, markdown_table, plot_error_against_time
 
-__all__ = ["Run", "load", "write_table", "load_sweep", "markdown_table", "plot_error_against_time"]
+__all__ = [
+    "Run",
+    "load",
+    "write_table",
+    "load_sweep",
+    "markdown_table",
+    "plot_error_against_time",
+    "cantilever_bending_modulus",
+]

@@ -28,6 +28,7 @@
 #endif
 #include "dem/bonds/bond_set.hpp"
 #include "dem/contacts/contact_law.hpp"
+#include "dem/sample_file.hpp"
 #include "support/cli.hpp"
 #include "support/omp_threads.hpp"
 
@@ -291,6 +292,55 @@ TEST(Cli, CheckWritesNothingNotEvenThePackingCache) {
   const auto run = test::run_arlequin("run " + (dir / "case.yaml").string() + " --quiet --out " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_TRUE(std::filesystem::exists(dir / "results" / "small_packing" / "sample.h5"));
+}
+
+// dem.sample.keep cuts a piece out of a packing: the DEs of the whole packing whose centre lies
+// in the region, at the same positions and in the same order, while the cache keeps the whole
+// packing for the specimen it belongs to; a region holding no DE is an error at the key.
+TEST(Samples, KeepCutsAPieceOfTheCachedPacking) {
+  const auto dir = test::scratch_dir("sample_keep");
+  const std::string head = "name: keep\n"
+                           "time: {end: 1.0e-6}\n"
+                           "dem:\n"
+                           "  density: 1600\n"
+                           "  bond: {law: beam, E_mu: 1.0e11, r_mu: 0.5}\n"
+                           "  sample:\n"
+                           "    build: packing\n"
+                           "    region: {box: [[0, 0, 0], [0.003, 0.003, 0.003]]}\n"
+                           "    compaction: 0.55\n"
+                           "    min_coordination: 4\n"
+                           "    radius: {mean: 2.5e-4}\n";
+  std::ofstream(dir / "whole.yaml") << head;
+  std::ofstream(dir / "piece.yaml") << head << "    file: results/keep/sample.h5\n"
+                                    << "    keep: {box: [[-1, -1, 0.0015], [0.002, 1, 1]]}\n";
+  std::ofstream(dir / "nothing.yaml") << head << "    keep: {box: [[1, 1, 1], [2, 2, 2]]}\n";
+  const app::Scene whole = app::build_scene(dir / "whole.yaml", {});
+  const app::Scene piece = app::build_scene(dir / "piece.yaml", {});
+  const auto& all = whole.dem.particles;
+  const auto& kept = piece.dem.particles;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const Vec3 x = all.position[i];
+    if (!(x.x <= 0.002 && x.z >= 0.0015)) continue;
+    ASSERT_LT(k, kept.size());
+    EXPECT_EQ(kept.position[k].x, x.x);
+    EXPECT_EQ(kept.position[k].z, x.z);
+    EXPECT_EQ(kept.radius[k], all.radius[i]);
+    ++k;
+  }
+  EXPECT_EQ(k, kept.size());
+  EXPECT_GT(k, all.size() / 5);
+  EXPECT_LT(k, all.size() / 2);
+  dem::ParticleSet cached;
+  dem::load_sample(dir / "results" / "keep" / "sample.h5", cached, 1600.0);
+  EXPECT_EQ(cached.size(), all.size()) << "the cache must hold the whole packing";
+  try {
+    (void)app::build_scene(dir / "nothing.yaml", {});
+    ADD_FAILURE() << "a keep region holding no DE was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("keep"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no DE"), std::string::npos) << e.what();
+  }
 }
 
 // A run killed outright (SIGKILL, a second Ctrl-C) leaves an index whose frames open: the XDMF
