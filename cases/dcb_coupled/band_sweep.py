@@ -17,7 +17,9 @@ commands also take --set dem.sample.radius.mean=1.75e-4 --set dem.sample.file=$P
 folder), the pure run the 20k load lines, --set "groups=$G" with G the third
 entry of cases/dcb/sweep_groups.txt, and the sweep --set coupling.continuum_substeps=3 and the
 20k arm's bending modulus, --set continuum.material.E=9.8e10 (cases/dcb/README.md; the README's
-table was measured before the case took the arms' bending modulus, at 135 GPa).
+table was measured before the case took the arms' bending modulus, at 135 GPa, and with P1 arms:
+--set continuum.mesh.file=../../meshes/dcb_arms.geo --set continuum.mesh.order=1 reproduces them;
+docs/decisions.md#d47, #d48).
 For each run: the band (half-thickness and overlap width, from its resolved case), its DEs and the
 continuum's degrees of freedom, the time loop's wall time, and against the pure-DEM run: P(Delta)
 (the largest |P / P_pure - 1| over Delta in [0.5, 2.0] mm, P_pure interpolated at the run's
