@@ -223,7 +223,7 @@ TEST(Dcb, ReducedDcbPropagatesAlongLefmAndBalancesEnergy) {
 // is the 40k arm's in bending (cases/dcb/README.md), which these arms are not, and the secant
 // ratio of the linear-opening test moves with it as the arms' ringing shifts in phase (+4.0 %
 // at 110 GPa against -2.0 % at 135). Their arms are P1 (the case's are P2, d48), forced every
-// step: the bounds below were measured so, and P2 would triple the cost of these runs.
+// step: the bounds below were measured so.
 const std::string coupled_case = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/dcb_coupled/case.yaml";
 const std::string reduced_coupled =
     " --quiet --set dem.sample.radius.mean=2.8e-4 --set dem.sample.file=../dcb/results/dcb_reduced/sample.h5"
