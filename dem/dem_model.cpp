@@ -328,8 +328,10 @@ void DemModel::drift(double dt) {
     // Spheres: omega is constant over the drift, so the rotation is exact.
     if (norm2(p.angular_velocity[i]) > 0.0)
       p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
-    p.force[i] = p.torque[i] = Vec3{};  // for the force pass: one pass over the DEs, not two
   });
+  // For the force pass, in a pass of its own: stores alone stream whole lines, where inside the
+  // loop above each waited for its line (docs/performance.md#clearing-forces).
+  p.clear_forces();
 }
 
 void DemModel::update_neighbours() {

@@ -25,7 +25,11 @@ std::size_t ParticleSet::add(const Vec3& x, double r, double density) {
 void ParticleSet::clear_forces() {
   // On the threads, split as the kicks and the drift, so each thread clears the DEs it updates.
   const long n = static_cast<long>(size());
-  for_each_index(n, n > parallel_threshold, [this](long i) { force[i] = torque[i] = Vec3{}; });
+  // Two plain stores: `force[i] = torque[i] = Vec3{}` read the cleared force back to copy it.
+  for_each_index(n, n > parallel_threshold, [f = force.data(), t = torque.data()](long i) {
+    f[i] = Vec3{};
+    t[i] = Vec3{};
+  });
 }
 
 void ParticleSet::move_entry(std::size_t from, std::size_t to) {
