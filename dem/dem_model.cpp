@@ -329,8 +329,8 @@ void DemModel::drift(double dt) {
     if (norm2(p.angular_velocity[i]) > 0.0)
       p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
   });
-  // For the force pass, in a pass of its own: stores alone stream whole lines, where inside the
-  // loop above each waited for its line (docs/performance.md#clearing-forces).
+  // For the force pass, in a pass of its own: inside the loop above, its stores took most of the
+  // drift's time (docs/performance.md#clearing-forces).
   p.clear_forces();
 }
 
