@@ -9,14 +9,18 @@
 //  - compute(u, w, f_int) overwrites f_int (3 values per node) with the force for the point
 //    weights w (w_q = alpha(x_q) |cell_q|, read at every call, so weights may change between
 //    calls). Nothing is allocated per call.
-//  - Layout (why a class): the points are grouped into batches of equal node count and material
-//    and stored lane-major (entry k of lane i at k * lanes + i), so that passes over a tile of
-//    lanes compute H, E, S and P of many points at once, vectorised for any node count. The
-//    tiles run on the OpenMP threads (above parallel_threshold entries), each writing its own
-//    entries' node forces into the entry's slot of one array ordered by node (each node's
-//    entries in the order of a serial scatter: batch, lane, entry); then every node sums its
-//    slots, a contiguous run, in that order, the nodes split over the threads: the same bits on
-//    any thread count, and the sum reads memory in sequence rather than an entry here and there.
+//  - Layout (why a class): consecutive points with the same nodes and material form a cell (an
+//    element's quadrature points; nem's points are cells of one point each). The cells are
+//    grouped into batches of equal node count, point count and material and stored lane-major
+//    (entry k of lane i at k * lanes + i), so that passes over a tile of lanes compute H, E, S
+//    and P of many points at once, vectorised for any node count, and sum each cell's points'
+//    forces on its nodes in the tile before they leave it: one entry per node of a cell, not per
+//    node of a point (a quadratic tetrahedron's four points write a quarter of the entries). The
+//    tiles run on the OpenMP threads (above parallel_threshold entries), each writing its cells'
+//    node forces into the entry's slot of one array ordered by node (each node's entries in the
+//    order of a serial scatter: batch, lane, entry); then every node sums its slots, a contiguous
+//    run, in that order, the nodes split over the threads: the same bits on any thread count,
+//    and the sum reads memory in sequence rather than an entry here and there.
 #pragma once
 #include <utility>
 #include <vector>
@@ -34,21 +38,29 @@ class FiniteStrainForce {
   void compute(const std::vector<double>& u, const std::vector<double>& w, std::vector<double>& f_int) const;
 
  private:
+  // Lanes are computed a tile at a time (its cells' node displacements and forces stay in the
+  // first-level cache): at most kTileLanes lanes and kTileEntries node entries, in vectors of
+  // kVec lanes.
+  static constexpr int kVec = 8, kTileLanes = 64, kTileEntries = 1024;
+  // A batch's arrays are tile by tile (tile n holds cells n * tile ..), so that a tile reads
+  // each in one contiguous run.
   struct Batch {
     int nodes_per_point = 0;  // m
+    int points_per_cell = 0;  // p
+    int cells = 0;            // its cells; the arrays are padded to whole tiles
+    int tile = 0;             // lanes a tile, whole vectors: m * tile <= kTileEntries
     Stiffness C;
-    std::vector<int> point;          // q of each lane
-    std::vector<int> dof;            // [k * lanes + i]: 3 x node of entry k of lane i
-    std::vector<double> gx, gy, gz;  // [k * lanes + i]
-    std::vector<int> slot;           // [k * lanes + i]: where entry k of lane i puts its force
+    std::vector<int> point;     // [(n * p + j) * tile + t]: point j of the cell in lane t of tile n
+    std::vector<int> dof;       // [(n * m + k) * tile + t]: 3 x node k of that cell
+    std::vector<int> slot;      // [(n * m + k) * tile + t]: where its entry k puts its force
+    std::vector<double> grad;   // [(((n * p + j) * m + k) * 3 + c) * tile + t]: grad N_k at point j, component c
+    int tiles() const { return (cells + tile - 1) / tile; }
   };
-  // Lanes are computed a tile at a time (the tile's H and P stay in registers and cache).
-  static constexpr int kTile = 256;
-  static void tile_forces(const Batch& b, int first, int count, const double* u, const double* w, double* slots);
+  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots);
   std::vector<Batch> batches_;
-  std::vector<std::pair<int, int>> tiles_;  // (batch, first lane) of every tile
-  // Every entry's force w_q P_q grad N_k (3 values) in its slot; node n's slots are
-  // slot_start_[n] .. slot_start_[n + 1].
+  std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
+  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its
+  // slot; node n's slots are slot_start_[n] .. slot_start_[n + 1].
   std::vector<int> slot_start_;
   mutable std::vector<double> slot_force_;
   long entries_ = 0;
