@@ -110,7 +110,8 @@ void ContinuumSolver::finish_setup() {
   if (kinematics_ == Kinematics::small) return;
   std::vector<Stiffness> stiffness;
   for (const Material& m : materials_) stiffness.push_back(m.C);
-  finite_force_ = FiniteStrainForce(points_.offset, points_.node, points_.grad, points_.material, stiffness);
+  finite_force_ =
+      FiniteStrainForce(points_.offset, points_.node, points_.grad, points_.material, stiffness, points_.basis, points_.coef);
 }
 
 void ContinuumSolver::set_weight(ScalarFunction alpha) {

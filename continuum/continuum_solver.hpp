@@ -195,6 +195,10 @@ class ContinuumSolver {
     std::vector<int> offset{0};
     std::vector<int> node;
     std::vector<Vec3> grad;
+    // Optional (empty if the method has none): grad[e] = sum_b coef[e]_b basis[q][b], the same
+    // combinations at the same point of every element (FiniteStrainForce reads the basis only).
+    std::vector<std::array<Vec3, 3>> basis;
+    std::vector<Vec3> coef;
   };
   // Derived constructors fill points_ and then call finish_setup().
   void finish_setup();

@@ -2,6 +2,7 @@
 #include "continuum/finite_strain_force.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <map>
 #include <stdexcept>
@@ -15,18 +16,35 @@ namespace arlequin::continuum {
 
 FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::vector<int>& node,
                                      const std::vector<Vec3>& grad, const std::vector<int>& material,
-                                     const std::vector<Stiffness>& stiffness) {
-  // Cells: runs of consecutive points with the same nodes, in the same order, and material.
+                                     const std::vector<Stiffness>& stiffness,
+                                     const std::vector<std::array<Vec3, 3>>& basis, const std::vector<Vec3>& coef) {
+  const bool factored = !basis.empty();
+  // Cells: runs of consecutive points with the same nodes, in the same order, material and
+  // basis.
   const int points = static_cast<int>(offset.size()) - 1;
   const auto same_cell = [&](int q, int r) {
     return material[q] == material[r] && offset[q + 1] - offset[q] == offset[r + 1] - offset[r] &&
-           std::equal(node.begin() + offset[q], node.begin() + offset[q + 1], node.begin() + offset[r]);
+           std::equal(node.begin() + offset[q], node.begin() + offset[q + 1], node.begin() + offset[r]) &&
+           (!factored || basis[static_cast<size_t>(q)] == basis[static_cast<size_t>(r)]);
   };
-  std::map<std::tuple<int, int, int>, std::vector<int>> groups;  // (node count, point count, material) -> first points
+  // Factored cells of one batch share their points' combinations: one table per batch.
+  std::map<std::vector<double>, int> tables;
+  std::vector<std::vector<double>> table_of;
+  // (node count, point count, material, table or -1) -> first points
+  std::map<std::tuple<int, int, int, int>, std::vector<int>> groups;
   for (int q = 0; q < points;) {
     int p = 1;
     while (q + p < points && same_cell(q, q + p)) ++p;
-    groups[{offset[q + 1] - offset[q], p, material[q]}].push_back(q);
+    int table = -1;
+    if (factored) {
+      std::vector<double> combination;
+      for (int e = offset[q]; e < offset[q + p]; ++e)
+        combination.insert(combination.end(), {coef[static_cast<size_t>(e)].x, coef[static_cast<size_t>(e)].y, coef[static_cast<size_t>(e)].z});
+      const auto [it, added] = tables.try_emplace(combination, static_cast<int>(table_of.size()));
+      if (added) table_of.push_back(combination);
+      table = it->second;
+    }
+    groups[{offset[q + 1] - offset[q], p, material[q], table}].push_back(q);
     q += p;
   }
   for (const auto& [key, firsts] : groups) {
@@ -39,20 +57,29 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     b.tile = std::min(kTileLanes, kTileEntries / b.nodes_per_point) / kVec * kVec;
     b.C = stiffness[static_cast<size_t>(std::get<2>(key))];
     b.cells = static_cast<int>(firsts.size());
-    // Whole tiles: the padding lanes have node 0, the batch's first point and zero gradients.
+    if (std::get<3>(key) >= 0) b.coef = table_of[static_cast<size_t>(std::get<3>(key))];
+    // Whole tiles: the padding lanes have node 0, the batch's first point and zero gradients
+    // (zero basis).
     const size_t m = static_cast<size_t>(b.nodes_per_point), np = static_cast<size_t>(b.points_per_cell);
     const size_t T = static_cast<size_t>(b.tile), lanes = static_cast<size_t>(b.tiles()) * T;
     b.point.assign(np * lanes, firsts[0]);
     b.dof.assign(m * lanes, 0);
-    b.grad.assign(3 * np * m * lanes, 0.0);
+    (b.factored() ? b.basis : b.grad).assign(b.factored() ? 9 * lanes : 3 * np * m * lanes, 0.0);
     for (size_t i = 0; i < firsts.size(); ++i) {
       const size_t n = i / T, t = i % T;
+      if (b.factored())
+        for (size_t r = 0; r < 3; ++r) {
+          const Vec3& v = basis[static_cast<size_t>(firsts[i])][r];
+          double* g = &b.basis[(n * 3 + r) * 3 * T + t];
+          g[0] = v.x, g[T] = v.y, g[2 * T] = v.z;
+        }
       for (size_t j = 0; j < np; ++j) {
         const int q = firsts[i] + static_cast<int>(j);
         b.point[(n * np + j) * T + t] = q;
         for (size_t k = 0; k < m; ++k) {
           const int e = offset[q] + static_cast<int>(k);
           if (j == 0) b.dof[(n * m + k) * T + t] = 3 * node[e];
+          if (b.factored()) continue;
           double* g = &b.grad[((n * np + j) * m + k) * 3 * T + t];
           g[0] = grad[e].x, g[T] = grad[e].y, g[2 * T] = grad[e].z;
         }
@@ -60,31 +87,34 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     }
     batches_.push_back(std::move(b));
   }
-  // Tiles, and each entry's slot: node by node, each node's entries in the serial scatter's
-  // order (batch, lane, entry).
+  // Tiles; each entry's force at its place in its tile's run (the batch's first entry + its
+  // index in dof), and each node's entries in the serial scatter's order (batch, lane, entry).
   int nodes = 0;
   for (int n : node) nodes = std::max(nodes, n + 1);
-  slot_start_.assign(static_cast<size_t>(nodes) + 1, 0);
+  node_start_.assign(static_cast<size_t>(nodes) + 1, 0);
+  long stored = 0;
   for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
     Batch& b = batches_[static_cast<size_t>(bi)];
     const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
     for (int n = 0; n < b.tiles(); ++n) tiles_.emplace_back(bi, n);
+    b.first_entry = stored;
+    stored += static_cast<long>(b.dof.size());
     for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
-      for (size_t k = 0; k < m; ++k) ++slot_start_[static_cast<size_t>(b.dof[(i / T * m + k) * T + i % T] / 3) + 1];
+      for (size_t k = 0; k < m; ++k) ++node_start_[static_cast<size_t>(b.dof[(i / T * m + k) * T + i % T] / 3) + 1];
     entries_ += static_cast<long>(m) * b.cells;
   }
-  for (int n = 0; n < nodes; ++n) slot_start_[static_cast<size_t>(n) + 1] += slot_start_[static_cast<size_t>(n)];
-  std::vector<int> next(slot_start_.begin(), slot_start_.end() - 1);
+  for (int n = 0; n < nodes; ++n) node_start_[static_cast<size_t>(n) + 1] += node_start_[static_cast<size_t>(n)];
+  std::vector<int> next(node_start_.begin(), node_start_.end() - 1);
+  node_entry_.resize(static_cast<size_t>(entries_));
   for (Batch& b : batches_) {
     const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
-    b.slot.assign(b.dof.size(), 0);
     for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
       for (size_t k = 0; k < m; ++k) {
         const size_t at = (i / T * m + k) * T + i % T;
-        b.slot[at] = next[static_cast<size_t>(b.dof[at] / 3)]++;
+        node_entry_[static_cast<size_t>(next[static_cast<size_t>(b.dof[at] / 3)]++)] = b.first_entry + static_cast<long>(at);
       }
   }
-  slot_force_.resize(3 * static_cast<size_t>(entries_));
+  entry_force_.resize(3 * static_cast<size_t>(stored));
 }
 
 namespace {
@@ -99,81 +129,112 @@ inline Lanes load(const double* p) {
 }
 inline void store(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 
+// w P = w (I + H) S(E) from H, lane by lane: the Green-Lagrange strain in Voigt order (xx, yy,
+// zz, yz, xz, xy; engineering shears 2 E_ij = H_ij + H_ji + sum_k H_ki H_kj), S = C E.
+inline void weighted_piola(const Lanes (&H)[3][3], const double (&c)[6][6], Lanes w, Lanes (&P)[3][3]) {
+  const Lanes h00 = H[0][0], h01 = H[0][1], h02 = H[0][2], h10 = H[1][0], h11 = H[1][1], h12 = H[1][2],
+              h20 = H[2][0], h21 = H[2][1], h22 = H[2][2];
+  const Lanes strain[6] = {h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20),
+                           h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21),
+                           h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22),
+                           h12 + h21 + h01 * h02 + h11 * h12 + h21 * h22,
+                           h02 + h20 + h00 * h02 + h10 * h12 + h20 * h22,
+                           h01 + h10 + h00 * h01 + h10 * h11 + h20 * h21};
+  Lanes s[6];
+  for (int r = 0; r < 6; ++r)
+    s[r] = c[r][0] * strain[0] + c[r][1] * strain[1] + c[r][2] * strain[2] + c[r][3] * strain[3] +
+           c[r][4] * strain[4] + c[r][5] * strain[5];
+  // S symmetric: rows (xx, xy, xz), (xy, yy, yz), (xz, yz, zz).
+  P[0][0] = w * ((1 + h00) * s[0] + h01 * s[5] + h02 * s[4]);
+  P[0][1] = w * ((1 + h00) * s[5] + h01 * s[1] + h02 * s[3]);
+  P[0][2] = w * ((1 + h00) * s[4] + h01 * s[3] + h02 * s[2]);
+  P[1][0] = w * (h10 * s[0] + (1 + h11) * s[5] + h12 * s[4]);
+  P[1][1] = w * (h10 * s[5] + (1 + h11) * s[1] + h12 * s[3]);
+  P[1][2] = w * (h10 * s[4] + (1 + h11) * s[3] + h12 * s[2]);
+  P[2][0] = w * (h20 * s[0] + h21 * s[5] + (1 + h22) * s[4]);
+  P[2][1] = w * (h20 * s[5] + h21 * s[1] + (1 + h22) * s[3]);
+  P[2][2] = w * (h20 * s[4] + h21 * s[3] + (1 + h22) * s[2]);
+}
+
 }  // namespace
 
 // Tile n of a batch, its lanes rounded up to whole vectors (the padding lanes have zero
 // gradients, so zero force, and are not written). The cells' node displacements are gathered
-// once for all their points; then, point by point and a vector of lanes at a time:
-// H = sum_k u_k (x) grad N_k, the Green-Lagrange strain in Voigt order (xx, yy, zz, yz, xz, xy;
-// engineering shears 2 E_ij = H_ij + H_ji + sum_k H_ki H_kj), S = C E and w P = w F S, all in
-// registers, and each entry's w P grad N added to the cell's force on that node. The cells' node
-// forces go to their slots at the end.
-void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots) {
+// once for all their points; then a vector of lanes at a time, point by point: H = sum_k u_k (x)
+// grad N_k, w P, and each entry's w P grad N added to the cell's force on that node, in
+// registers. A factored batch never reads a gradient: with grad N_k = sum_b A_kb B_b (B the
+// cell's basis, A the batch's table at that point), H = sum_b U_b (x) B_b with U_b = sum_k A_kb
+// u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces go to the
+// tile's run of entries at the end.
+template <bool factored>
+void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, const double* w, double* entries) {
   static_assert(sizeof(Lanes) == kVec * sizeof(double));
   const int m = b.nodes_per_point, np = b.points_per_cell, T = b.tile;
   const int count = std::min(T, b.cells - n * T), padded = (count + kVec - 1) / kVec * kVec;
   const int* dof = b.dof.data() + static_cast<size_t>(n) * m * T;
-  const int* slot = b.slot.data() + static_cast<size_t>(n) * m * T;
   double c[6][6];
   for (int r = 0; r < 6; ++r)
     for (int s = 0; s < 6; ++s) c[r][s] = b.C(r, s);
   double ux[kTileEntries], uy[kTileEntries], uz[kTileEntries];  // [k * T + t]
   double fx[kTileEntries], fy[kTileEntries], fz[kTileEntries];
   for (int e = 0; e < m * T; ++e) ux[e] = u[dof[e]], uy[e] = u[dof[e] + 1], uz[e] = u[dof[e] + 2];
-  double wq[kTileLanes];
-  for (int j = 0; j < np; ++j) {
-    const double* grad = b.grad.data() + (static_cast<size_t>(n) * np + j) * m * 3 * T;
-    const int* point = b.point.data() + (static_cast<size_t>(n) * np + j) * T;
-    for (int t = 0; t < padded; ++t) wq[t] = w[point[t]];
-    for (int t = 0; t < padded; t += kVec) {
-      Lanes h00{}, h01{}, h02{}, h10{}, h11{}, h12{}, h20{}, h21{}, h22{};
-      for (int k = 0; k < m; ++k) {
-        const double* g = grad + 3 * k * T + t;
-        const Lanes ax = load(g), ay = load(g + T), az = load(g + 2 * T);
-        const Lanes u0 = load(ux + k * T + t), u1 = load(uy + k * T + t), u2 = load(uz + k * T + t);
-        h00 += u0 * ax, h01 += u0 * ay, h02 += u0 * az;
-        h10 += u1 * ax, h11 += u1 * ay, h12 += u1 * az;
-        h20 += u2 * ax, h21 += u2 * ay, h22 += u2 * az;
-      }
-      const Lanes strain[6] = {h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20),
-                               h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21),
-                               h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22),
-                               h12 + h21 + h01 * h02 + h11 * h12 + h21 * h22,
-                               h02 + h20 + h00 * h02 + h10 * h12 + h20 * h22,
-                               h01 + h10 + h00 * h01 + h10 * h11 + h20 * h21};
-      Lanes s[6];
-      for (int r = 0; r < 6; ++r)
-        s[r] = c[r][0] * strain[0] + c[r][1] * strain[1] + c[r][2] * strain[2] + c[r][3] * strain[3] +
-               c[r][4] * strain[4] + c[r][5] * strain[5];
-      // w P = w (I + H) S, S symmetric: rows (xx, xy, xz), (xy, yy, yz), (xz, yz, zz).
-      const Lanes wt = load(wq + t);
-      const Lanes p00 = wt * ((1 + h00) * s[0] + h01 * s[5] + h02 * s[4]);
-      const Lanes p01 = wt * ((1 + h00) * s[5] + h01 * s[1] + h02 * s[3]);
-      const Lanes p02 = wt * ((1 + h00) * s[4] + h01 * s[3] + h02 * s[2]);
-      const Lanes p10 = wt * (h10 * s[0] + (1 + h11) * s[5] + h12 * s[4]);
-      const Lanes p11 = wt * (h10 * s[5] + (1 + h11) * s[1] + h12 * s[3]);
-      const Lanes p12 = wt * (h10 * s[4] + (1 + h11) * s[3] + h12 * s[2]);
-      const Lanes p20 = wt * (h20 * s[0] + h21 * s[5] + (1 + h22) * s[4]);
-      const Lanes p21 = wt * (h20 * s[5] + h21 * s[1] + (1 + h22) * s[3]);
-      const Lanes p22 = wt * (h20 * s[4] + h21 * s[3] + (1 + h22) * s[2]);
-      for (int k = 0; k < m; ++k) {
-        const double* g = grad + 3 * k * T + t;
-        const Lanes ax = load(g), ay = load(g + T), az = load(g + 2 * T);
-        const Lanes x = p00 * ax + p01 * ay + p02 * az;
-        const Lanes y = p10 * ax + p11 * ay + p12 * az;
-        const Lanes z = p20 * ax + p21 * ay + p22 * az;
-        double *ox = fx + k * T + t, *oy = fy + k * T + t, *oz = fz + k * T + t;
-        if (j == 0) {
-          store(ox, x), store(oy, y), store(oz, z);
-        } else {
-          store(ox, load(ox) + x), store(oy, load(oy) + y), store(oz, load(oz) + z);
+  for (int t = 0; t < padded; t += kVec) {
+    Lanes B[3][3];  // factored: B[b][d], component d of the cell's basis vector b
+    if constexpr (factored)
+      for (int r = 0; r < 3; ++r)
+        for (int d = 0; d < 3; ++d) B[r][d] = load(b.basis.data() + ((static_cast<size_t>(n) * 3 + r) * 3 + d) * T + t);
+    for (int j = 0; j < np; ++j) {
+      const double* A = nullptr;     // factored: A[3 k + b]
+      const double* grad = nullptr;  // not: the points' gradients
+      if constexpr (factored) A = b.coef.data() + 3 * j * m;
+      else grad = b.grad.data() + (static_cast<size_t>(n) * np + j) * m * 3 * T + t;
+      Lanes H[3][3];
+      if constexpr (factored) {
+        Lanes U[3][3] = {};  // U[b][c]
+        for (int k = 0; k < m; ++k) {
+          const Lanes uk[3] = {load(ux + k * T + t), load(uy + k * T + t), load(uz + k * T + t)};
+          for (int r = 0; r < 3; ++r)
+            for (int cc = 0; cc < 3; ++cc) U[r][cc] += A[3 * k + r] * uk[cc];
         }
+        for (int cc = 0; cc < 3; ++cc)
+          for (int d = 0; d < 3; ++d) H[cc][d] = U[0][cc] * B[0][d] + U[1][cc] * B[1][d] + U[2][cc] * B[2][d];
+      } else {
+        for (auto& row : H) row[0] = row[1] = row[2] = Lanes{};
+        for (int k = 0; k < m; ++k) {
+          const double* g = grad + 3 * k * T;
+          const Lanes a[3] = {load(g), load(g + T), load(g + 2 * T)};
+          const Lanes uk[3] = {load(ux + k * T + t), load(uy + k * T + t), load(uz + k * T + t)};
+          for (int cc = 0; cc < 3; ++cc)
+            for (int d = 0; d < 3; ++d) H[cc][d] += uk[cc] * a[d];
+        }
+      }
+      const int* point = b.point.data() + (static_cast<size_t>(n) * np + j) * T + t;
+      Lanes wt;
+      for (int l = 0; l < kVec; ++l) wt[l] = w[point[l]];
+      Lanes P[3][3];
+      weighted_piola(H, c, wt, P);
+      Lanes Q[3][3];  // factored: Q[c][b] = (w P B_b)_c
+      if constexpr (factored)
+        for (int cc = 0; cc < 3; ++cc)
+          for (int r = 0; r < 3; ++r) Q[cc][r] = P[cc][0] * B[r][0] + P[cc][1] * B[r][1] + P[cc][2] * B[r][2];
+      for (int k = 0; k < m; ++k) {
+        Lanes f[3];
+        if constexpr (factored) {
+          for (int cc = 0; cc < 3; ++cc) f[cc] = A[3 * k] * Q[cc][0] + A[3 * k + 1] * Q[cc][1] + A[3 * k + 2] * Q[cc][2];
+        } else {
+          const double* g = grad + 3 * k * T;
+          const Lanes a[3] = {load(g), load(g + T), load(g + 2 * T)};
+          for (int cc = 0; cc < 3; ++cc) f[cc] = P[cc][0] * a[0] + P[cc][1] * a[1] + P[cc][2] * a[2];
+        }
+        double* out[3] = {fx + k * T + t, fy + k * T + t, fz + k * T + t};
+        for (int cc = 0; cc < 3; ++cc) store(out[cc], j == 0 ? f[cc] : load(out[cc]) + f[cc]);
       }
     }
   }
+  double* run = entries + 3 * (b.first_entry + static_cast<long>(n) * m * T);
   for (int k = 0; k < m; ++k)
     for (int t = 0; t < count; ++t) {
-      double* out = slots + 3 * static_cast<size_t>(slot[k * T + t]);
+      double* out = run + 3 * (k * T + t);
       out[0] = fx[k * T + t], out[1] = fy[k * T + t], out[2] = fz[k * T + t];
     }
 }
@@ -181,19 +242,21 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
-  const long nodes = static_cast<long>(slot_start_.size()) - 1;
-  double* slots = slot_force_.data();
+  const long nodes = static_cast<long>(node_start_.size()) - 1;
+  double* entries = entry_force_.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
 #pragma omp for schedule(static)
     for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
       const auto [bi, n] = tiles_[static_cast<size_t>(t)];
-      tile_forces(batches_[static_cast<size_t>(bi)], n, u.data(), w.data(), slots);
+      const Batch& b = batches_[static_cast<size_t>(bi)];
+      if (b.factored()) tile_forces<true>(b, n, u.data(), w.data(), entries);
+      else tile_forces<false>(b, n, u.data(), w.data(), entries);
     }
 #pragma omp for schedule(static)
     for (long n = 0; n < nodes; ++n) {
       double f[3] = {0.0, 0.0, 0.0};
-      for (int s = slot_start_[static_cast<size_t>(n)]; s < slot_start_[static_cast<size_t>(n) + 1]; ++s)
-        for (int c = 0; c < 3; ++c) f[c] += slots[3 * static_cast<size_t>(s) + c];
+      for (int s = node_start_[static_cast<size_t>(n)]; s < node_start_[static_cast<size_t>(n) + 1]; ++s)
+        for (int c = 0; c < 3; ++c) f[c] += entries[3 * node_entry_[static_cast<size_t>(s)] + c];
       for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
     }
   });

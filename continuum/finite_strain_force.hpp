@@ -6,22 +6,26 @@
 // Contract
 //  - Built once from the points (compressed rows: point q has the nodes node[offset[q] ..
 //    offset[q+1]) with gradients grad[...] and material index material[q] into `stiffness`).
+//    Optionally factored: where each gradient is a fixed combination of three vectors of its
+//    element, grad[e] = sum_b coef[e]_b basis[q][b] (fe: the barycentric gradients), `basis` (per
+//    point) and `coef` (per entry) let the force read nine numbers an element instead of its
+//    points' gradients (empty: not factored).
 //  - compute(u, w, f_int) overwrites f_int (3 values per node) with the force for the point
 //    weights w (w_q = alpha(x_q) |cell_q|, read at every call, so weights may change between
 //    calls). Nothing is allocated per call.
 //  - Layout (why a class): consecutive points with the same nodes and material form a cell (an
 //    element's quadrature points; nem's points are cells of one point each). The cells are
-//    grouped into batches of equal node count, point count and material and stored lane-major
-//    (entry k of lane i at k * lanes + i), so that passes over a tile of lanes compute H, E, S
-//    and P of many points at once, vectorised for any node count, and sum each cell's points'
-//    forces on its nodes in the tile before they leave it: one entry per node of a cell, not per
-//    node of a point (a quadratic tetrahedron's four points write a quarter of the entries). The
-//    tiles run on the OpenMP threads (above parallel_threshold entries), each writing its cells'
-//    node forces into the entry's slot of one array ordered by node (each node's entries in the
-//    order of a serial scatter: batch, lane, entry); then every node sums its slots, a contiguous
-//    run, in that order, the nodes split over the threads: the same bits on any thread count,
-//    and the sum reads memory in sequence rather than an entry here and there.
+//    grouped into batches of equal node count, point count and material and stored tile by
+//    tile, lane-major within a tile (entry k of lane t at k * tile + t), so that a pass over a
+//    tile computes H, E, S and P of a vector of points at once, for any node count, and sums
+//    each cell's points' forces on its nodes before they leave it: one entry per node of a
+//    cell, not per node of a point (a quadratic tetrahedron's four points write a quarter of
+//    the entries). The tiles run on the OpenMP threads (above parallel_threshold entries), each
+//    writing its entries' forces in one contiguous run; then every node sums its entries in
+//    the order of a serial scatter (batch, lane, entry), the nodes split over the threads: the
+//    same bits on any thread count.
 #pragma once
+#include <array>
 #include <utility>
 #include <vector>
 
@@ -34,7 +38,8 @@ class FiniteStrainForce {
  public:
   FiniteStrainForce() = default;
   FiniteStrainForce(const std::vector<int>& offset, const std::vector<int>& node, const std::vector<Vec3>& grad,
-                    const std::vector<int>& material, const std::vector<Stiffness>& stiffness);
+                    const std::vector<int>& material, const std::vector<Stiffness>& stiffness,
+                    const std::vector<std::array<Vec3, 3>>& basis = {}, const std::vector<Vec3>& coef = {});
   void compute(const std::vector<double>& u, const std::vector<double>& w, std::vector<double>& f_int) const;
 
  private:
@@ -52,17 +57,25 @@ class FiniteStrainForce {
     Stiffness C;
     std::vector<int> point;     // [(n * p + j) * tile + t]: point j of the cell in lane t of tile n
     std::vector<int> dof;       // [(n * m + k) * tile + t]: 3 x node k of that cell
-    std::vector<int> slot;      // [(n * m + k) * tile + t]: where its entry k puts its force
+    // Not factored: the gradients.
     std::vector<double> grad;   // [(((n * p + j) * m + k) * 3 + c) * tile + t]: grad N_k at point j, component c
+    // Factored: each cell's basis and the batch's combinations.
+    std::vector<double> basis;  // [((n * 3 + b) * 3 + c) * tile + t]: basis vector b, component c
+    std::vector<double> coef;   // [(j * m + k) * 3 + b]: grad N_k at point j = sum_b coef B_b
+    long first_entry = 0;       // of its entries' forces in entry_force_
     int tiles() const { return (cells + tile - 1) / tile; }
+    bool factored() const { return !coef.empty(); }
   };
-  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots);
+  template <bool factored>
+  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* entries);
   std::vector<Batch> batches_;
   std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
-  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its
-  // slot; node n's slots are slot_start_[n] .. slot_start_[n + 1].
-  std::vector<int> slot_start_;
-  mutable std::vector<double> slot_force_;
+  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), tile by
+  // tile as the batches store their dofs (padding entries unused); node n's entries are
+  // node_entry_[node_start_[n] .. node_start_[n + 1]).
+  std::vector<int> node_start_;
+  std::vector<long> node_entry_;
+  mutable std::vector<double> entry_force_;
   long entries_ = 0;
 };
 

@@ -64,7 +64,11 @@ FeSolver::FeSolver(const ContinuumSettings& settings) : ContinuumSolver(settings
   const std::vector<std::array<double, 4>> rule =
       order == 1 ? std::vector<std::array<double, 4>>{{0.25, 0.25, 0.25, 0.25}}
                  : std::vector<std::array<double, 4>>(kQuad.begin(), kQuad.end());
-  std::array<Vec3, 10> G;
+  // Every gradient is a combination of the element's barycentric gradients grad lambda_1..3
+  // (grad lambda_0 = -their sum), the same at the same point of every element: the shape
+  // gradients with grad lambda_b the unit vectors are those combinations.
+  const std::array<Vec3, 4> unit{Vec3{-1.0, -1.0, -1.0}, Vec3{1.0, 0.0, 0.0}, Vec3{0.0, 1.0, 0.0}, Vec3{0.0, 0.0, 1.0}};
+  std::array<Vec3, 10> G, A;
   for (int e = 0; e < ne; ++e) {
     const int* t = mesh_.tet(e);
     const double V = mesh_.tet_volume(e);
@@ -73,9 +77,12 @@ FeSolver::FeSolver(const ContinuumSettings& settings) : ContinuumSolver(settings
       points_.volume.push_back(V / static_cast<double>(rule.size()));
       points_.material.push_back(tet_material_[e]);
       shape_gradients(order, l, grad_lambda_[e], G.data());
+      shape_gradients(order, l, unit, A.data());
+      points_.basis.push_back({grad_lambda_[e][1], grad_lambda_[e][2], grad_lambda_[e][3]});
       for (int a = 0; a < npe; ++a) {
         points_.node.push_back(t[a]);
         points_.grad.push_back(G[a]);
+        points_.coef.push_back(A[a]);
       }
       points_.offset.push_back(static_cast<int>(points_.node.size()));
     }
