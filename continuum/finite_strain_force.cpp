@@ -87,34 +87,31 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     }
     batches_.push_back(std::move(b));
   }
-  // Tiles; each entry's force at its place in its tile's run (the batch's first entry + its
-  // index in dof), and each node's entries in the serial scatter's order (batch, lane, entry).
+  // Tiles, and each entry's slot: node by node, each node's entries in the serial scatter's
+  // order (batch, lane, entry).
   int nodes = 0;
   for (int n : node) nodes = std::max(nodes, n + 1);
-  node_start_.assign(static_cast<size_t>(nodes) + 1, 0);
-  long stored = 0;
+  slot_start_.assign(static_cast<size_t>(nodes) + 1, 0);
   for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
     Batch& b = batches_[static_cast<size_t>(bi)];
     const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
     for (int n = 0; n < b.tiles(); ++n) tiles_.emplace_back(bi, n);
-    b.first_entry = stored;
-    stored += static_cast<long>(b.dof.size());
     for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
-      for (size_t k = 0; k < m; ++k) ++node_start_[static_cast<size_t>(b.dof[(i / T * m + k) * T + i % T] / 3) + 1];
+      for (size_t k = 0; k < m; ++k) ++slot_start_[static_cast<size_t>(b.dof[(i / T * m + k) * T + i % T] / 3) + 1];
     entries_ += static_cast<long>(m) * b.cells;
   }
-  for (int n = 0; n < nodes; ++n) node_start_[static_cast<size_t>(n) + 1] += node_start_[static_cast<size_t>(n)];
-  std::vector<int> next(node_start_.begin(), node_start_.end() - 1);
-  node_entry_.resize(static_cast<size_t>(entries_));
+  for (int n = 0; n < nodes; ++n) slot_start_[static_cast<size_t>(n) + 1] += slot_start_[static_cast<size_t>(n)];
+  std::vector<int> next(slot_start_.begin(), slot_start_.end() - 1);
   for (Batch& b : batches_) {
     const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
+    b.slot.assign(b.dof.size(), 0);
     for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
       for (size_t k = 0; k < m; ++k) {
         const size_t at = (i / T * m + k) * T + i % T;
-        node_entry_[static_cast<size_t>(next[static_cast<size_t>(b.dof[at] / 3)]++)] = b.first_entry + static_cast<long>(at);
+        b.slot[at] = next[static_cast<size_t>(b.dof[at] / 3)]++;
       }
   }
-  entry_force_.resize(3 * static_cast<size_t>(stored));
+  slot_force_.resize(3 * static_cast<size_t>(entries_));
 }
 
 namespace {
@@ -164,14 +161,15 @@ inline void weighted_piola(const Lanes (&H)[3][3], const double (&c)[6][6], Lane
 // grad N_k, w P, and each entry's w P grad N added to the cell's force on that node, in
 // registers. A factored batch never reads a gradient: with grad N_k = sum_b A_kb B_b (B the
 // cell's basis, A the batch's table at that point), H = sum_b U_b (x) B_b with U_b = sum_k A_kb
-// u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces go to the
-// tile's run of entries at the end.
+// u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces go to their
+// slots at the end.
 template <bool factored>
-void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, const double* w, double* entries) {
+void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots) {
   static_assert(sizeof(Lanes) == kVec * sizeof(double));
   const int m = b.nodes_per_point, np = b.points_per_cell, T = b.tile;
   const int count = std::min(T, b.cells - n * T), padded = (count + kVec - 1) / kVec * kVec;
   const int* dof = b.dof.data() + static_cast<size_t>(n) * m * T;
+  const int* slot = b.slot.data() + static_cast<size_t>(n) * m * T;
   double c[6][6];
   for (int r = 0; r < 6; ++r)
     for (int s = 0; s < 6; ++s) c[r][s] = b.C(r, s);
@@ -231,10 +229,9 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
       }
     }
   }
-  double* run = entries + 3 * (b.first_entry + static_cast<long>(n) * m * T);
   for (int k = 0; k < m; ++k)
     for (int t = 0; t < count; ++t) {
-      double* out = run + 3 * (k * T + t);
+      double* out = slots + 3 * static_cast<size_t>(slot[k * T + t]);
       out[0] = fx[k * T + t], out[1] = fy[k * T + t], out[2] = fz[k * T + t];
     }
 }
@@ -242,21 +239,21 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
-  const long nodes = static_cast<long>(node_start_.size()) - 1;
-  double* entries = entry_force_.data();
+  const long nodes = static_cast<long>(slot_start_.size()) - 1;
+  double* slots = slot_force_.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
 #pragma omp for schedule(static)
     for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
       const auto [bi, n] = tiles_[static_cast<size_t>(t)];
       const Batch& b = batches_[static_cast<size_t>(bi)];
-      if (b.factored()) tile_forces<true>(b, n, u.data(), w.data(), entries);
-      else tile_forces<false>(b, n, u.data(), w.data(), entries);
+      if (b.factored()) tile_forces<true>(b, n, u.data(), w.data(), slots);
+      else tile_forces<false>(b, n, u.data(), w.data(), slots);
     }
 #pragma omp for schedule(static)
     for (long n = 0; n < nodes; ++n) {
       double f[3] = {0.0, 0.0, 0.0};
-      for (int s = node_start_[static_cast<size_t>(n)]; s < node_start_[static_cast<size_t>(n) + 1]; ++s)
-        for (int c = 0; c < 3; ++c) f[c] += entries[3 * node_entry_[static_cast<size_t>(s)] + c];
+      for (int s = slot_start_[static_cast<size_t>(n)]; s < slot_start_[static_cast<size_t>(n) + 1]; ++s)
+        for (int c = 0; c < 3; ++c) f[c] += slots[3 * static_cast<size_t>(s) + c];
       for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
     }
   });

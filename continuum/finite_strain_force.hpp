@@ -21,9 +21,10 @@
 //    each cell's points' forces on its nodes before they leave it: one entry per node of a
 //    cell, not per node of a point (a quadratic tetrahedron's four points write a quarter of
 //    the entries). The tiles run on the OpenMP threads (above parallel_threshold entries), each
-//    writing its entries' forces in one contiguous run; then every node sums its entries in
-//    the order of a serial scatter (batch, lane, entry), the nodes split over the threads: the
-//    same bits on any thread count.
+//    writing its entries' forces into their slots of one array ordered by node (each node's
+//    entries in the order of a serial scatter: batch, lane, entry); then every node sums its
+//    slots, a contiguous run, in that order, the nodes split over the threads: the same bits on
+//    any thread count, and the sum reads memory in sequence (docs/performance.md says why).
 #pragma once
 #include <array>
 #include <utility>
@@ -62,20 +63,18 @@ class FiniteStrainForce {
     // Factored: each cell's basis and the batch's combinations.
     std::vector<double> basis;  // [((n * 3 + b) * 3 + c) * tile + t]: basis vector b, component c
     std::vector<double> coef;   // [(j * m + k) * 3 + b]: grad N_k at point j = sum_b coef B_b
-    long first_entry = 0;       // of its entries' forces in entry_force_
+    std::vector<int> slot;      // [(n * m + k) * tile + t]: where its entry k puts its force
     int tiles() const { return (cells + tile - 1) / tile; }
     bool factored() const { return !coef.empty(); }
   };
   template <bool factored>
-  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* entries);
+  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots);
   std::vector<Batch> batches_;
   std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
-  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), tile by
-  // tile as the batches store their dofs (padding entries unused); node n's entries are
-  // node_entry_[node_start_[n] .. node_start_[n + 1]).
-  std::vector<int> node_start_;
-  std::vector<long> node_entry_;
-  mutable std::vector<double> entry_force_;
+  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its
+  // slot; node n's slots are slot_start_[n] .. slot_start_[n + 1].
+  std::vector<int> slot_start_;
+  mutable std::vector<double> slot_force_;
   long entries_ = 0;
 };
 
