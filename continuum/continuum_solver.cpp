@@ -660,14 +660,7 @@ void ContinuumSolver::solve_static(const std::string& petsc_options) {
 }
 
 double ContinuumSolver::strain_energy() const {
-  if (kinematics_ == Kinematics::finite) {
-    double e = 0.0;
-    for (size_t q = 0; q < points_.x.size(); ++q) {
-      const Voigt E = strain_at(static_cast<int>(q), u_);
-      e += 0.5 * point_weight_[q] * E.dot(materials_[points_.material[q]].C * E);
-    }
-    return e;
-  }
+  if (kinematics_ == Kinematics::finite) return finite_force_.energy(u_, point_weight_);
   stiffness().multiply(u_, ku_);
   double e = 0;
   for (size_t d = 0; d < u_.size(); ++d) e += u_[d] * ku_[d];

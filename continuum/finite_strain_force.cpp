@@ -112,6 +112,7 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
       }
   }
   slot_force_.resize(3 * static_cast<size_t>(entries_));
+  tile_energy_.resize(tiles_.size());
 }
 
 namespace {
@@ -126,22 +127,26 @@ inline Lanes load(const double* p) {
 }
 inline void store(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 
-// w P = w (I + H) S(E) from H, lane by lane: the Green-Lagrange strain in Voigt order (xx, yy,
-// zz, yz, xz, xy; engineering shears 2 E_ij = H_ij + H_ji + sum_k H_ki H_kj), S = C E.
-inline void weighted_piola(const Lanes (&H)[3][3], const double (&c)[6][6], Lanes w, Lanes (&P)[3][3]) {
+// From H, lane by lane: the Green-Lagrange strain in Voigt order (xx, yy, zz, yz, xz, xy;
+// engineering shears 2 E_ij = H_ij + H_ji + sum_k H_ki H_kj) and S = C E.
+inline void strain_and_stress(const Lanes (&H)[3][3], const double (&c)[6][6], Lanes (&strain)[6], Lanes (&s)[6]) {
   const Lanes h00 = H[0][0], h01 = H[0][1], h02 = H[0][2], h10 = H[1][0], h11 = H[1][1], h12 = H[1][2],
               h20 = H[2][0], h21 = H[2][1], h22 = H[2][2];
-  const Lanes strain[6] = {h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20),
-                           h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21),
-                           h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22),
-                           h12 + h21 + h01 * h02 + h11 * h12 + h21 * h22,
-                           h02 + h20 + h00 * h02 + h10 * h12 + h20 * h22,
-                           h01 + h10 + h00 * h01 + h10 * h11 + h20 * h21};
-  Lanes s[6];
+  strain[0] = h00 + 0.5 * (h00 * h00 + h10 * h10 + h20 * h20);
+  strain[1] = h11 + 0.5 * (h01 * h01 + h11 * h11 + h21 * h21);
+  strain[2] = h22 + 0.5 * (h02 * h02 + h12 * h12 + h22 * h22);
+  strain[3] = h12 + h21 + h01 * h02 + h11 * h12 + h21 * h22;
+  strain[4] = h02 + h20 + h00 * h02 + h10 * h12 + h20 * h22;
+  strain[5] = h01 + h10 + h00 * h01 + h10 * h11 + h20 * h21;
   for (int r = 0; r < 6; ++r)
     s[r] = c[r][0] * strain[0] + c[r][1] * strain[1] + c[r][2] * strain[2] + c[r][3] * strain[3] +
            c[r][4] * strain[4] + c[r][5] * strain[5];
-  // S symmetric: rows (xx, xy, xz), (xy, yy, yz), (xz, yz, zz).
+}
+
+// w P = w (I + H) S, S symmetric: rows (xx, xy, xz), (xy, yy, yz), (xz, yz, zz).
+inline void weighted_piola(const Lanes (&H)[3][3], const Lanes (&s)[6], Lanes w, Lanes (&P)[3][3]) {
+  const Lanes h00 = H[0][0], h01 = H[0][1], h02 = H[0][2], h10 = H[1][0], h11 = H[1][1], h12 = H[1][2],
+              h20 = H[2][0], h21 = H[2][1], h22 = H[2][2];
   P[0][0] = w * ((1 + h00) * s[0] + h01 * s[5] + h02 * s[4]);
   P[0][1] = w * ((1 + h00) * s[5] + h01 * s[1] + h02 * s[3]);
   P[0][2] = w * ((1 + h00) * s[4] + h01 * s[3] + h02 * s[2]);
@@ -156,15 +161,17 @@ inline void weighted_piola(const Lanes (&H)[3][3], const double (&c)[6][6], Lane
 }  // namespace
 
 // Tile n of a batch, its lanes rounded up to whole vectors (the padding lanes have zero
-// gradients, so zero force, and are not written). The cells' node displacements are gathered
+// gradients, so zero force and energy, and are not written). With `energy`: only the tile's
+// strain energy, sum over its points of w E . S / 2, summed lane by lane and then over the
+// lanes in order, is computed (and returned; 0 otherwise). The cells' node displacements are gathered
 // once for all their points; then a vector of lanes at a time, point by point: H = sum_k u_k (x)
 // grad N_k, w P, and each entry's w P grad N added to the cell's force on that node, in
 // registers. A factored batch never reads a gradient: with grad N_k = sum_b A_kb B_b (B the
 // cell's basis, A the batch's table at that point), H = sum_b U_b (x) B_b with U_b = sum_k A_kb
 // u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces go to their
 // slots at the end.
-template <bool factored>
-void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots) {
+template <bool factored, bool energy>
+double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, const double* w, double* slots) {
   static_assert(sizeof(Lanes) == kVec * sizeof(double));
   const int m = b.nodes_per_point, np = b.points_per_cell, T = b.tile;
   const int count = std::min(T, b.cells - n * T), padded = (count + kVec - 1) / kVec * kVec;
@@ -176,6 +183,7 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
   double ux[kTileEntries], uy[kTileEntries], uz[kTileEntries];  // [k * T + t]
   double fx[kTileEntries], fy[kTileEntries], fz[kTileEntries];
   for (int e = 0; e < m * T; ++e) ux[e] = u[dof[e]], uy[e] = u[dof[e] + 1], uz[e] = u[dof[e] + 2];
+  Lanes tile_energy{};
   for (int t = 0; t < padded; t += kVec) {
     Lanes B[3][3];  // factored: B[b][d], component d of the cell's basis vector b
     if constexpr (factored)
@@ -209,8 +217,14 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
       const int* point = b.point.data() + (static_cast<size_t>(n) * np + j) * T + t;
       Lanes wt;
       for (int l = 0; l < kVec; ++l) wt[l] = w[point[l]];
+      Lanes strain[6], S[6];
+      strain_and_stress(H, c, strain, S);
+      if constexpr (energy) {
+        tile_energy += 0.5 * wt * (strain[0] * S[0] + strain[1] * S[1] + strain[2] * S[2] + strain[3] * S[3] + strain[4] * S[4] + strain[5] * S[5]);
+        continue;
+      }
       Lanes P[3][3];
-      weighted_piola(H, c, wt, P);
+      weighted_piola(H, S, wt, P);
       Lanes Q[3][3];  // factored: Q[c][b] = (w P B_b)_c
       if constexpr (factored)
         for (int cc = 0; cc < 3; ++cc)
@@ -229,11 +243,17 @@ void FiniteStrainForce::tile_forces(const Batch& b, int n, const double* u, cons
       }
     }
   }
+  if constexpr (energy) {
+    double sum = 0.0;
+    for (int l = 0; l < kVec; ++l) sum += tile_energy[l];
+    return sum;
+  }
   for (int k = 0; k < m; ++k)
     for (int t = 0; t < count; ++t) {
       double* out = slots + 3 * static_cast<size_t>(slot[k * T + t]);
       out[0] = fx[k * T + t], out[1] = fy[k * T + t], out[2] = fz[k * T + t];
     }
+  return 0.0;
 }
 
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
@@ -246,8 +266,8 @@ void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<
     for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
       const auto [bi, n] = tiles_[static_cast<size_t>(t)];
       const Batch& b = batches_[static_cast<size_t>(bi)];
-      if (b.factored()) tile_forces<true>(b, n, u.data(), w.data(), slots);
-      else tile_forces<false>(b, n, u.data(), w.data(), slots);
+      if (b.factored()) tile_pass<true, false>(b, n, u.data(), w.data(), slots);
+      else tile_pass<false, false>(b, n, u.data(), w.data(), slots);
     }
 #pragma omp for schedule(static)
     for (long n = 0; n < nodes; ++n) {
@@ -257,6 +277,24 @@ void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<
       for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
     }
   });
+}
+
+// Each tile's energy on the threads, then their sum in tile order: the same bits on any thread
+// count.
+double FiniteStrainForce::energy(const std::vector<double>& u, const std::vector<double>& w) const {
+  double* tile_energy = tile_energy_.data();
+  run_threaded_if(entries_ > parallel_threshold, [&] {
+#pragma omp for schedule(static)
+    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
+      const auto [bi, n] = tiles_[static_cast<size_t>(t)];
+      const Batch& b = batches_[static_cast<size_t>(bi)];
+      tile_energy[t] = b.factored() ? tile_pass<true, true>(b, n, u.data(), w.data(), nullptr)
+                                    : tile_pass<false, true>(b, n, u.data(), w.data(), nullptr);
+    }
+  });
+  double sum = 0.0;
+  for (double e : tile_energy_) sum += e;
+  return sum;
 }
 
 }  // namespace arlequin::continuum

@@ -12,7 +12,8 @@
 //    points' gradients (empty: not factored).
 //  - compute(u, w, f_int) overwrites f_int (3 values per node) with the force for the point
 //    weights w (w_q = alpha(x_q) |cell_q|, read at every call, so weights may change between
-//    calls). Nothing is allocated per call.
+//    calls); energy(u, w) the strain energy sum_q w_q E_q . C E_q / 2 (the same tiles, H
+//    computed as for the force). Nothing is allocated per call.
 //  - Layout (why a class): consecutive points with the same nodes and material form a cell (an
 //    element's quadrature points; nem's points are cells of one point each). The cells are
 //    grouped into batches of equal node count, point count and material and stored tile by
@@ -42,6 +43,8 @@ class FiniteStrainForce {
                     const std::vector<int>& material, const std::vector<Stiffness>& stiffness,
                     const std::vector<std::array<Vec3, 3>>& basis = {}, const std::vector<Vec3>& coef = {});
   void compute(const std::vector<double>& u, const std::vector<double>& w, std::vector<double>& f_int) const;
+  // The strain energy sum_q w_q E_q . C E_q / 2 of the same points and weights.
+  double energy(const std::vector<double>& u, const std::vector<double>& w) const;
 
  private:
   // Lanes are computed a tile at a time (its cells' node displacements and forces stay in the
@@ -67,14 +70,15 @@ class FiniteStrainForce {
     int tiles() const { return (cells + tile - 1) / tile; }
     bool factored() const { return !coef.empty(); }
   };
-  template <bool factored>
-  static void tile_forces(const Batch& b, int n, const double* u, const double* w, double* slots);
+  template <bool factored, bool energy>
+  static double tile_pass(const Batch& b, int n, const double* u, const double* w, double* slots);
   std::vector<Batch> batches_;
   std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
   // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its
   // slot; node n's slots are slot_start_[n] .. slot_start_[n + 1].
   std::vector<int> slot_start_;
   mutable std::vector<double> slot_force_;
+  mutable std::vector<double> tile_energy_;
   long entries_ = 0;
 };
 
