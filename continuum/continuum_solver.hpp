@@ -196,7 +196,8 @@ class ContinuumSolver {
     std::vector<int> node;
     std::vector<Vec3> grad;
     // Optional (empty if the method has none): grad[e] = sum_b coef[e]_b basis[q][b], the same
-    // combinations at the same point of every element (FiniteStrainForce reads the basis only).
+    // combinations at the same point of every element (FiniteStrainForce then reads these, not
+    // grad).
     std::vector<std::array<Vec3, 3>> basis;
     std::vector<Vec3> coef;
   };

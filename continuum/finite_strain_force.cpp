@@ -256,6 +256,13 @@ double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, cons
   return 0.0;
 }
 
+template <bool energy>
+double FiniteStrainForce::tile(long t, const double* u, const double* w, double* slots) const {
+  const auto [bi, n] = tiles_[static_cast<size_t>(t)];
+  const Batch& b = batches_[static_cast<size_t>(bi)];
+  return b.factored() ? tile_pass<true, energy>(b, n, u, w, slots) : tile_pass<false, energy>(b, n, u, w, slots);
+}
+
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
@@ -263,12 +270,7 @@ void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<
   double* slots = slot_force_.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
 #pragma omp for schedule(static)
-    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
-      const auto [bi, n] = tiles_[static_cast<size_t>(t)];
-      const Batch& b = batches_[static_cast<size_t>(bi)];
-      if (b.factored()) tile_pass<true, false>(b, n, u.data(), w.data(), slots);
-      else tile_pass<false, false>(b, n, u.data(), w.data(), slots);
-    }
+    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) tile<false>(t, u.data(), w.data(), slots);
 #pragma omp for schedule(static)
     for (long n = 0; n < nodes; ++n) {
       double f[3] = {0.0, 0.0, 0.0};
@@ -285,12 +287,7 @@ double FiniteStrainForce::energy(const std::vector<double>& u, const std::vector
   double* tile_energy = tile_energy_.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
 #pragma omp for schedule(static)
-    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) {
-      const auto [bi, n] = tiles_[static_cast<size_t>(t)];
-      const Batch& b = batches_[static_cast<size_t>(bi)];
-      tile_energy[t] = b.factored() ? tile_pass<true, true>(b, n, u.data(), w.data(), nullptr)
-                                    : tile_pass<false, true>(b, n, u.data(), w.data(), nullptr);
-    }
+    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) tile_energy[t] = tile<true>(t, u.data(), w.data(), nullptr);
   });
   double sum = 0.0;
   for (double e : tile_energy_) sum += e;

@@ -72,6 +72,9 @@ class FiniteStrainForce {
   };
   template <bool factored, bool energy>
   static double tile_pass(const Batch& b, int n, const double* u, const double* w, double* slots);
+  // tile_pass of tiles_[t], for its batch's kind of gradients.
+  template <bool energy>
+  double tile(long t, const double* u, const double* w, double* slots) const;
   std::vector<Batch> batches_;
   std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
   // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its

@@ -66,23 +66,25 @@ FeSolver::FeSolver(const ContinuumSettings& settings) : ContinuumSolver(settings
                  : std::vector<std::array<double, 4>>(kQuad.begin(), kQuad.end());
   // Every gradient is a combination of the element's barycentric gradients grad lambda_1..3
   // (grad lambda_0 = -their sum), the same at the same point of every element: the shape
-  // gradients with grad lambda_b the unit vectors are those combinations.
+  // gradients with grad lambda_b the unit vectors are those combinations, one set per point.
   const std::array<Vec3, 4> unit{Vec3{-1.0, -1.0, -1.0}, Vec3{1.0, 0.0, 0.0}, Vec3{0.0, 1.0, 0.0}, Vec3{0.0, 0.0, 1.0}};
-  std::array<Vec3, 10> G, A;
+  std::vector<std::array<Vec3, 10>> combination(rule.size());
+  for (size_t r = 0; r < rule.size(); ++r) shape_gradients(order, rule[r], unit, combination[r].data());
+  std::array<Vec3, 10> G;
   for (int e = 0; e < ne; ++e) {
     const int* t = mesh_.tet(e);
     const double V = mesh_.tet_volume(e);
-    for (const auto& l : rule) {
+    for (size_t r = 0; r < rule.size(); ++r) {
+      const auto& l = rule[r];
       points_.x.push_back(l[0] * X[t[0]] + l[1] * X[t[1]] + l[2] * X[t[2]] + l[3] * X[t[3]]);
       points_.volume.push_back(V / static_cast<double>(rule.size()));
       points_.material.push_back(tet_material_[e]);
       shape_gradients(order, l, grad_lambda_[e], G.data());
-      shape_gradients(order, l, unit, A.data());
       points_.basis.push_back({grad_lambda_[e][1], grad_lambda_[e][2], grad_lambda_[e][3]});
       for (int a = 0; a < npe; ++a) {
         points_.node.push_back(t[a]);
         points_.grad.push_back(G[a]);
-        points_.coef.push_back(A[a]);
+        points_.coef.push_back(combination[r][static_cast<size_t>(a)]);
       }
       points_.offset.push_back(static_cast<int>(points_.node.size()));
     }
