@@ -182,10 +182,18 @@ void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matr
     for (Eigen::Index j = 0; j < k; ++j) dc->row(a.node[static_cast<std::size_t>(j)]) = w_.row(j);
 }
 
+// A depends on the continuum's inverse masses only at the nodes G_c reaches: a node held in one
+// component far from the overlap (a load strip) leaves the components' systems the same.
 int MultiplierSolver::system_of_earlier_component(int c) const {
   const auto& tied = ops_->tied;
+  const auto same_reached_masses = [&](int b) {
+    for (int r = 0; r < ops_->Gc.outerSize(); ++r)
+      for (SparseMatrix::InnerIterator it(ops_->Gc, r); it; ++it)
+        if (inv_c_(it.col(), b) != inv_c_(it.col(), c)) return false;
+    return true;
+  };
   for (int b = 0; b < c; ++b)
-    if (inv_c_.col(b) == inv_c_.col(c) && (tied.size() == 0 || tied.col(b) == tied.col(c))) return factor_of_[b];
+    if ((tied.size() == 0 || tied.col(b) == tied.col(c)) && same_reached_masses(b)) return factor_of_[b];
   return -1;
 }
 

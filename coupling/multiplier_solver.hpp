@@ -77,7 +77,7 @@ class MultiplierSolver {
   // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
 
-  // Distinct systems (one per distinct column of inverse masses and ties; the others reuse one).
+  // Distinct systems (one per distinct column of ties and reached inverse masses; the others reuse one).
   int systems() const { return systems_; }
   // "LDL^T", "diagonal + low rank (Woodbury), LDL^T of <k> continuum nodes a system ..." or "PETSc <ksp> + <pc>".
   std::string backend() const;
@@ -108,8 +108,8 @@ class MultiplierSolver {
   void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
   // The components system k serves (the first `width` entries) and their number.
   std::pair<std::array<int, 3>, int> served_by(int k) const;
-  // The system of an earlier component with the same continuum inverse masses and ties (the DEs'
-  // masses are the same for all three components), or -1.
+  // The system of an earlier component with the same ties and the same continuum inverse masses
+  // at the nodes G_c reaches (the DEs' masses are the same for all three components), or -1.
   int system_of_earlier_component(int c) const;
 
   const CouplingOperators* ops_;

@@ -158,6 +158,36 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   EXPECT_EQ(vc_w(2, 1), vc(2, 1));                      // the held dof
 }
 
+// A held dof at a node no row reaches (a load strip far from the overlap) does not split the
+// components' systems: A reads the continuum's inverse masses only where G_c has entries. With a
+// ninth node, held along z and reached by no DE, x and z still share one system (two in all, as
+// without it), and the multipliers are those of the eight-node operators to the bit.
+TEST(CouplingMultiplierSolver, AHeldNodeNoRowReachesLeavesTheSystemsShared) {
+  const auto [fine, md, mc] = shared_nodes();
+  const int np = fine.num_particles(), nn = static_cast<int>(fine.Gc.cols());
+  CouplingOperators wider = fine;
+  wider.N.conservativeResize(np, nn + 1);
+  wider.Gc.conservativeResize(np, nn + 1);
+  std::vector<double> mc_wider = mc;
+  mc_wider.insert(mc_wider.end(), {mc[0], mc[1], 0.0});  // node 8: held along z
+  for (const bool woodbury : {true, false}) {
+    CouplingOperators a = fine, b = wider;
+    if (!woodbury) a.settings.mediator = b.settings.mediator = Mediator::coarse;  // the general factor
+    const MultiplierSolver eight(a, md, mc, std::nullopt), nine(b, md, mc_wider, std::nullopt);
+    EXPECT_EQ(nine.systems(), 2) << nine.backend();
+    Matrix3 vd(np, 3), vc8(nn, 3), vc9(nn + 1, 3);
+    for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
+    for (int i = 0; i < nn; ++i) vc8.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
+    vc9.topRows(nn) = vc8;
+    vc9.row(nn) << 1.0, 2.0, 3.0;
+    Matrix3 vd8 = vd, vd9 = vd, dd, dc, lambda8, lambda9;
+    eight.project(vd8, vc8, dd, dc, lambda8);
+    nine.project(vd9, vc9, dd, dc, lambda9);
+    EXPECT_EQ(lambda9, lambda8) << nine.backend();
+    EXPECT_EQ(vc9.row(nn), Eigen::RowVector3d(1.0, 2.0, 3.0)) << nine.backend();  // no row reaches it
+  }
+}
+
 // Partial ties (CouplingOperators::tied): in a component a row leaves free there is no
 // multiplier and both velocities stay; in the held ones they meet at the momentum-weighted mean
 // (one_to_one's closed form). The masses are the same in x, y and z, the ties are not: three
