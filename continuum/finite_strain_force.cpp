@@ -87,31 +87,41 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
     }
     batches_.push_back(std::move(b));
   }
-  // Tiles, and each entry's slot: node by node, each node's entries in the serial scatter's
-  // order (batch, lane, entry).
+  // Tiles in colours: no two tiles of a colour share a node, so a colour's tiles add their
+  // cells' forces straight into f_int on any threads, and each node's sum runs in one order
+  // (colour, tile, entry) on any thread count. Greedy, in the tiles' order: a colour takes every
+  // tile left that shares no node with one it holds.
   int nodes = 0;
   for (int n : node) nodes = std::max(nodes, n + 1);
-  slot_start_.assign(static_cast<size_t>(nodes) + 1, 0);
+  std::vector<std::pair<int, int>> left;
   for (int bi = 0; bi < static_cast<int>(batches_.size()); ++bi) {
-    Batch& b = batches_[static_cast<size_t>(bi)];
-    const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
-    for (int n = 0; n < b.tiles(); ++n) tiles_.emplace_back(bi, n);
-    for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
-      for (size_t k = 0; k < m; ++k) ++slot_start_[static_cast<size_t>(b.dof[(i / T * m + k) * T + i % T] / 3) + 1];
-    entries_ += static_cast<long>(m) * b.cells;
+    const Batch& b = batches_[static_cast<size_t>(bi)];
+    for (int n = 0; n < b.tiles(); ++n) left.emplace_back(bi, n);
+    entries_ += static_cast<long>(b.nodes_per_point) * b.cells;
   }
-  for (int n = 0; n < nodes; ++n) slot_start_[static_cast<size_t>(n) + 1] += slot_start_[static_cast<size_t>(n)];
-  std::vector<int> next(slot_start_.begin(), slot_start_.end() - 1);
-  for (Batch& b : batches_) {
-    const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
-    b.slot.assign(b.dof.size(), 0);
-    for (size_t i = 0; i < static_cast<size_t>(b.cells); ++i)
-      for (size_t k = 0; k < m; ++k) {
-        const size_t at = (i / T * m + k) * T + i % T;
-        b.slot[at] = next[static_cast<size_t>(b.dof[at] / 3)]++;
+  std::vector<int> taken_by(static_cast<size_t>(nodes), -1);  // the last colour that took the node
+  colour_start_.push_back(0);
+  for (int colour = 0; !left.empty(); ++colour) {
+    std::vector<std::pair<int, int>> later;
+    for (const auto& [bi, n] : left) {
+      const Batch& b = batches_[static_cast<size_t>(bi)];
+      const size_t m = static_cast<size_t>(b.nodes_per_point), T = static_cast<size_t>(b.tile);
+      const int* dof = b.dof.data() + static_cast<size_t>(n) * m * T;
+      const size_t count = static_cast<size_t>(std::min(b.tile, b.cells - n * b.tile));
+      bool free = true;
+      for (size_t k = 0; k < m && free; ++k)
+        for (size_t t = 0; t < count && free; ++t) free = taken_by[static_cast<size_t>(dof[k * T + t] / 3)] != colour;
+      if (!free) {
+        later.emplace_back(bi, n);
+        continue;
       }
+      for (size_t k = 0; k < m; ++k)
+        for (size_t t = 0; t < count; ++t) taken_by[static_cast<size_t>(dof[k * T + t] / 3)] = colour;
+      tiles_.emplace_back(bi, n);
+    }
+    colour_start_.push_back(static_cast<int>(tiles_.size()));
+    left.swap(later);
   }
-  slot_force_.resize(3 * static_cast<size_t>(entries_));
   tile_energy_.resize(tiles_.size());
 }
 
@@ -161,22 +171,21 @@ inline void weighted_piola(const Lanes (&H)[3][3], const Lanes (&s)[6], Lanes w,
 }  // namespace
 
 // Tile n of a batch, its lanes rounded up to whole vectors (the padding lanes have zero
-// gradients, so zero force and energy, and are not written). With `energy`: only the tile's
+// gradients, so zero force and energy, and are not added). With `energy`: only the tile's
 // strain energy, sum over its points of w E . S / 2, summed lane by lane and then over the
 // lanes in order, is computed (and returned; 0 otherwise). The cells' node displacements are gathered
 // once for all their points; then a vector of lanes at a time, point by point: H = sum_k u_k (x)
 // grad N_k, w P, and each entry's w P grad N added to the cell's force on that node, in
 // registers. A factored batch never reads a gradient: with grad N_k = sum_b A_kb B_b (B the
 // cell's basis, A the batch's table at that point), H = sum_b U_b (x) B_b with U_b = sum_k A_kb
-// u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces go to their
-// slots at the end.
+// u_k, and w P grad N_k = sum_b A_kb Q_b with Q_b = w P B_b. The cells' node forces are added to
+// f at the end (no other tile of the colour touches those nodes).
 template <bool factored, bool energy>
-double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, const double* w, double* slots) {
+double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, const double* w, double* f_int) {
   static_assert(sizeof(Lanes) == kVec * sizeof(double));
   const int m = b.nodes_per_point, np = b.points_per_cell, T = b.tile;
   const int count = std::min(T, b.cells - n * T), padded = (count + kVec - 1) / kVec * kVec;
   const int* dof = b.dof.data() + static_cast<size_t>(n) * m * T;
-  const int* slot = b.slot.data() + static_cast<size_t>(n) * m * T;
   double c[6][6];
   for (int r = 0; r < 6; ++r)
     for (int s = 0; s < 6; ++s) c[r][s] = b.C(r, s);
@@ -250,33 +259,27 @@ double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, cons
   }
   for (int k = 0; k < m; ++k)
     for (int t = 0; t < count; ++t) {
-      double* out = slots + 3 * static_cast<size_t>(slot[k * T + t]);
-      out[0] = fx[k * T + t], out[1] = fy[k * T + t], out[2] = fz[k * T + t];
+      double* out = f_int + dof[k * T + t];
+      out[0] += fx[k * T + t], out[1] += fy[k * T + t], out[2] += fz[k * T + t];
     }
   return 0.0;
 }
 
 template <bool energy>
-double FiniteStrainForce::tile(long t, const double* u, const double* w, double* slots) const {
+double FiniteStrainForce::tile(long t, const double* u, const double* w, double* f) const {
   const auto [bi, n] = tiles_[static_cast<size_t>(t)];
   const Batch& b = batches_[static_cast<size_t>(bi)];
-  return b.factored() ? tile_pass<true, energy>(b, n, u, w, slots) : tile_pass<false, energy>(b, n, u, w, slots);
+  return b.factored() ? tile_pass<true, energy>(b, n, u, w, f) : tile_pass<false, energy>(b, n, u, w, f);
 }
 
 void FiniteStrainForce::compute(const std::vector<double>& u, const std::vector<double>& w,
                                 std::vector<double>& f_int) const {
   f_int.assign(u.size(), 0.0);
-  const long nodes = static_cast<long>(slot_start_.size()) - 1;
-  double* slots = slot_force_.data();
+  double* f = f_int.data();
   run_threaded_if(entries_ > parallel_threshold, [&] {
+    for (size_t c = 0; c + 1 < colour_start_.size(); ++c) {
 #pragma omp for schedule(static)
-    for (long t = 0; t < static_cast<long>(tiles_.size()); ++t) tile<false>(t, u.data(), w.data(), slots);
-#pragma omp for schedule(static)
-    for (long n = 0; n < nodes; ++n) {
-      double f[3] = {0.0, 0.0, 0.0};
-      for (int s = slot_start_[static_cast<size_t>(n)]; s < slot_start_[static_cast<size_t>(n) + 1]; ++s)
-        for (int c = 0; c < 3; ++c) f[c] += slots[3 * static_cast<size_t>(s) + c];
-      for (int c = 0; c < 3; ++c) f_int[static_cast<size_t>(3 * n + c)] = f[c];
+      for (long t = colour_start_[c]; t < colour_start_[c + 1]; ++t) tile<false>(t, u.data(), w.data(), f);
     }
   });
 }

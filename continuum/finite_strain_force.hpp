@@ -21,11 +21,11 @@
 //    tile computes H, E, S and P of a vector of points at once, for any node count, and sums
 //    each cell's points' forces on its nodes before they leave it: one entry per node of a
 //    cell, not per node of a point (a quadratic tetrahedron's four points write a quarter of
-//    the entries). The tiles run on the OpenMP threads (above parallel_threshold entries), each
-//    writing its entries' forces into their slots of one array ordered by node (each node's
-//    entries in the order of a serial scatter: batch, lane, entry); then every node sums its
-//    slots, a contiguous run, in that order, the nodes split over the threads: the same bits on
-//    any thread count, and the sum reads memory in sequence (docs/performance.md says why).
+//    the entries). The tiles are coloured so that no two tiles of a colour share a node; a
+//    colour's tiles run on the OpenMP threads (above parallel_threshold entries), each adding its
+//    cells' node forces straight into f_int, a barrier between colours: every node's sum runs in
+//    one order (colour, tile, entry), the same bits on any thread count, and no per-entry array
+//    is written and read back (docs/performance.md says why).
 #pragma once
 #include <array>
 #include <utility>
@@ -66,21 +66,17 @@ class FiniteStrainForce {
     // Factored: each cell's basis and the batch's combinations.
     std::vector<double> basis;  // [((n * 3 + b) * 3 + c) * tile + t]: basis vector b, component c
     std::vector<double> coef;   // [(j * m + k) * 3 + b]: grad N_k at point j = sum_b coef B_b
-    std::vector<int> slot;      // [(n * m + k) * tile + t]: where its entry k puts its force
     int tiles() const { return (cells + tile - 1) / tile; }
     bool factored() const { return !coef.empty(); }
   };
   template <bool factored, bool energy>
-  static double tile_pass(const Batch& b, int n, const double* u, const double* w, double* slots);
+  static double tile_pass(const Batch& b, int n, const double* u, const double* w, double* f_int);
   // tile_pass of tiles_[t], for its batch's kind of gradients.
   template <bool energy>
-  double tile(long t, const double* u, const double* w, double* slots) const;
+  double tile(long t, const double* u, const double* w, double* f) const;
   std::vector<Batch> batches_;
-  std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile
-  // Every entry's force, sum_q w_q P_q grad_q N_k over its cell's points (3 values), in its
-  // slot; node n's slots are slot_start_[n] .. slot_start_[n + 1].
-  std::vector<int> slot_start_;
-  mutable std::vector<double> slot_force_;
+  std::vector<std::pair<int, int>> tiles_;  // (batch, tile) of every tile, colour by colour
+  std::vector<int> colour_start_;           // colour c's tiles are tiles_[colour_start_[c] .. colour_start_[c + 1])
   mutable std::vector<double> tile_energy_;
   long entries_ = 0;
 };
