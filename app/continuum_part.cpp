@@ -84,8 +84,9 @@ constexpr KeyDoc coupling_keys[] = {
      "plain | consistent"},
     {"solver", KeyType::choice, "", {}, "petsc", "the multiplier solve: PETSc (options below) or our sparse LDL^T", "petsc | direct"},
     {"petsc_options", KeyType::string, "", {}, "", "solver: petsc: PETSc options of the multiplier system (prefix coupling_)"},
-    {"continuum_substeps", KeyType::integer, "", Range::at_least(1), "1",
-     "the continuum's internal force once every this many steps, as two impulses (multiple time stepping)"},
+    {"continuum_substeps", KeyType::integer_or_auto, "", Range::between(1, 1000), "1",
+     "the continuum's internal force once every this many steps, as two impulses (multiple time stepping); "
+     "auto: the most steps whose sum stays within the continuum's critical step"},
     {"on_damage_in_overlap", KeyType::choice, "", {}, "stop",
      "a bond the coupling weights (weight < 1) breaks: stop the run, say so once and go on, or hold such bonds intact "
      "(say so once)", "stop | warn | hold"},
@@ -348,7 +349,8 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   const std::string on_damage_in_overlap = section.choice_or("on_damage_in_overlap", "stop", on_damage);
   out.stop_on_damage_in_overlap = on_damage_in_overlap == "stop";
   out.options.hold_overlap_failures = on_damage_in_overlap == "hold";
-  out.options.continuum_substeps = int(section.integer_or("continuum_substeps", 1, Range::at_least(1)));
+  const std::optional<long long> substeps = section.integer_or_auto("continuum_substeps", 1, Range::between(1, 1000));
+  out.options.continuum_substeps = substeps ? static_cast<int>(*substeps) : 0;  // 0: auto
   for (CaseNode tie : section.list_or_empty("ties")) {
     out.ties.push_back({tie, tie.string("group"), read_components(tie)});
     tie.finish();

@@ -508,6 +508,22 @@ long long CaseNode::integer_or(std::string_view key, long long fallback, Range r
   return integer(key, range);
 }
 
+std::optional<long long> CaseNode::integer_or_auto(std::string_view key, long long fallback, Range range) {
+  const std::string fallback_text = std::to_string(fallback);
+  check_schema(key, KeyType::integer_or_auto, &range, {}, &fallback_text);
+  const Entry e = lookup(key);
+  if (!e.present()) {
+    record_->put(key, Kind::Plain, fallback_text);
+    return fallback;
+  }
+  if (e.value.IsScalar() && e.value.Scalar() == "auto") {
+    record_->put(key, Kind::Plain, "auto");
+    return std::nullopt;
+  }
+  if (!parse_number(e.value)) mismatch(e, number_text("an integer", range, "") + " or 'auto'");
+  return integer(key, range);
+}
+
 bool CaseNode::boolean(std::string_view key) {
   check_schema(key, KeyType::boolean);
   const Entry e = lookup(key);
@@ -789,7 +805,8 @@ std::string CaseNode::check_schema(std::string_view key, KeyType type, const Ran
   const bool presence_test = type == KeyType::section && doc->type != KeyType::section && doc->type != KeyType::names;
   if (presence_test) return declared_at;  // has(key): a test of presence, whatever the key's type
   const bool mapping = doc->type == KeyType::names && type == KeyType::section;
-  const bool number_part = doc->type == KeyType::number_or_auto && type == KeyType::number;  // number_or_auto reads via number
+  const bool number_part = (doc->type == KeyType::number_or_auto && type == KeyType::number) ||
+                           (doc->type == KeyType::integer_or_auto && type == KeyType::integer);  // ..._or_auto read via number / integer
   if (doc->type != type && !mapping && !number_part) throw std::logic_error(where + ": read as " + std::string(name_of(type)) + ", declared " + std::string(name_of(doc->type)));
   const bool unit_varies = doc->unit.starts_with("(");  // "(by type)": the reader states it per case
   if (range && !unit_varies && !(doc->range == *range)) throw std::logic_error(where + ": read with range '" + range->describe() + "', declared '" + doc->range.describe() + "'");

@@ -112,6 +112,8 @@ class CaseNode {
   std::optional<double> number_or_auto(std::string_view key, Range range, std::string_view unit);
   long long integer(std::string_view key, Range range);
   long long integer_or(std::string_view key, long long fallback, Range range);
+  // An integer or the word `auto` (nullopt); a missing key means the fallback.
+  std::optional<long long> integer_or_auto(std::string_view key, long long fallback, Range range);
   bool boolean(std::string_view key);
   bool boolean_or(std::string_view key, bool fallback);
   std::string string(std::string_view key);

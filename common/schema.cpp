@@ -11,6 +11,7 @@ std::string_view name_of(KeyType type) {
     case KeyType::number: return "number";
     case KeyType::number_or_auto: return "number or auto";
     case KeyType::integer: return "integer";
+    case KeyType::integer_or_auto: return "integer or auto";
     case KeyType::boolean: return "true | false";
     case KeyType::string: return "string";
     case KeyType::choice: return "choice";

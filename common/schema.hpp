@@ -24,6 +24,7 @@ enum class KeyType {
   number,          // number / number_or
   number_or_auto,  // a number or the word auto
   integer,
+  integer_or_auto,  // an integer or the word auto
   boolean,
   string,
   choice,  // one of `values`

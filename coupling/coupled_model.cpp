@@ -104,6 +104,9 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
 
   time_steps_.dem = dem_.critical_time_step();
   time_steps_.continuum = continuum_.critical_time_step();
+  if (options_.continuum_substeps == 0)  // auto (header)
+    options_.continuum_substeps = std::max(1, static_cast<int>(std::floor(time_steps_.continuum / time_steps_.dem)));
+  time_steps_.continuum_substeps = options_.continuum_substeps;
   time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum / options_.continuum_substeps);
 }
 

@@ -59,6 +59,7 @@
 //    impulse form: Tuckerman, Berne & Martyna, J. Chem. Phys. 97 (1992); still time-reversible
 //    and symplectic); the continuum drifts and the constraint is solved every step. m = 1 is
 //    step 2 and 3 above.
+//    m = 0 (auto) takes m = floor(continuum / DEM critical step), at least 1 (time_steps() says).
 //  - critical_time_step() = min(DEM, continuum / m): the constrained system's highest frequency
 //    is at most the larger of the two (Rayleigh quotient over a subspace), and the continuum's
 //    macro step m dt must stay below its own.
@@ -98,7 +99,9 @@ struct CoupledOptions {
   // Bonds of the overlap (alpha_d < 1 at their midpoint) do not break when their criterion is
   // met: the continuum they share the load with cannot (coupling.on_damage_in_overlap: hold).
   bool hold_overlap_failures = false;
-  // The continuum's internal force evaluated every this many steps (coupling.continuum_substeps).
+  // The continuum's internal force evaluated every this many steps (coupling.continuum_substeps);
+  // 0: auto, the largest m whose macro step m dt_DEM stays within the continuum's critical step
+  // (floor(dt_continuum / dt_DEM), at least 1), so that the continuum never sets the step.
   int continuum_substeps = 1;
   // Per DE of the scene, the components its coupling holds (coupling.ties); empty: all three.
   std::vector<std::array<bool, 3>> tied_components;
@@ -111,7 +114,8 @@ std::vector<int> group_dofs(const continuum::ContinuumSolver& continuum, const s
 struct TimeSteps {
   double dem = 0.0;        // s, DEM critical step (weighted masses and bonds)
   double continuum = 0.0;  // s, continuum critical step (weighted)
-  double coupled = 0.0;    // s, min of both
+  double coupled = 0.0;    // s, min of the DEM's and the continuum's / m
+  int continuum_substeps = 1;  // m: the continuum's internal force once every m steps
 };
 
 struct CoupledEnergies {

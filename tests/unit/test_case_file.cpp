@@ -168,6 +168,18 @@ TEST_F(CaseFileTest, WrongTypeRangeUnitSuffixAndNonInteger) {
                   "expected a number > 0 [s] or 'auto', got 'abc'");
 }
 
+TEST_F(CaseFileTest, IntegerOrAutoReadsAWholeNumberTheWordAutoOrTheFallback) {
+  CaseFile c = load("s:\n  a: 3\n  b: auto\n  c: 2.5\n  d: many\n");
+  CaseNode s = c.root().child("s");
+  const Range range = Range::between(1, 1000);
+  EXPECT_EQ(s.integer_or_auto("a", 1, range), std::optional<long long>(3));
+  EXPECT_FALSE(s.integer_or_auto("b", 1, range).has_value());
+  EXPECT_EQ(s.integer_or_auto("missing", 7, range), std::optional<long long>(7));
+  EXPECT_CONTAINS(error_of([&] { s.integer_or_auto("c", 1, range); }), "case.yaml:4: s.c: expected an integer in [1, 1000], got 2.5");
+  EXPECT_CONTAINS(error_of([&] { s.integer_or_auto("d", 1, range); }),
+                  "case.yaml:5: s.d: expected an integer in [1, 1000] or 'auto', got 'many'");
+}
+
 TEST_F(CaseFileTest, BadChoiceSuggestsClosest) {
   CaseFile c = load("dem:\n  element: bem\n");
   CaseNode dem = c.root().child("dem");
