@@ -80,8 +80,8 @@ FiniteStrainForce::FiniteStrainForce(const std::vector<int>& offset, const std::
           const int e = offset[q] + static_cast<int>(k);
           if (j == 0) b.dof[(n * m + k) * T + t] = 3 * node[e];
           if (b.factored()) continue;
-          double* g = &b.grad[((n * np + j) * m + k) * 3 * T + t];
-          g[0] = grad[e].x, g[T] = grad[e].y, g[2 * T] = grad[e].z;
+          double* g = &b.grad[((n * np + j) * T + t / kVec * kVec) * m * 3 + k * 3 * kVec + t % kVec];
+          g[0] = grad[e].x, g[kVec] = grad[e].y, g[2 * kVec] = grad[e].z;
         }
       }
     }
@@ -202,7 +202,7 @@ double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, cons
       const double* A = nullptr;     // factored: A[3 k + b]
       const double* grad = nullptr;  // not: the points' gradients
       if constexpr (factored) A = b.coef.data() + 3 * j * m;
-      else grad = b.grad.data() + (static_cast<size_t>(n) * np + j) * m * 3 * T + t;
+      else grad = b.grad.data() + ((static_cast<size_t>(n) * np + j) * T + t) * m * 3;
       Lanes H[3][3];
       if constexpr (factored) {
         Lanes U[3][3] = {};  // U[b][c]
@@ -216,8 +216,8 @@ double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, cons
       } else {
         for (auto& row : H) row[0] = row[1] = row[2] = Lanes{};
         for (int k = 0; k < m; ++k) {
-          const double* g = grad + 3 * k * T;
-          const Lanes a[3] = {load(g), load(g + T), load(g + 2 * T)};
+          const double* g = grad + 3 * k * kVec;
+          const Lanes a[3] = {load(g), load(g + kVec), load(g + 2 * kVec)};
           const Lanes uk[3] = {load(ux + k * T + t), load(uy + k * T + t), load(uz + k * T + t)};
           for (int cc = 0; cc < 3; ++cc)
             for (int d = 0; d < 3; ++d) H[cc][d] += uk[cc] * a[d];
@@ -243,8 +243,8 @@ double FiniteStrainForce::tile_pass(const Batch& b, int n, const double* u, cons
         if constexpr (factored) {
           for (int cc = 0; cc < 3; ++cc) f[cc] = A[3 * k] * Q[cc][0] + A[3 * k + 1] * Q[cc][1] + A[3 * k + 2] * Q[cc][2];
         } else {
-          const double* g = grad + 3 * k * T;
-          const Lanes a[3] = {load(g), load(g + T), load(g + 2 * T)};
+          const double* g = grad + 3 * k * kVec;
+          const Lanes a[3] = {load(g), load(g + kVec), load(g + 2 * kVec)};
           for (int cc = 0; cc < 3; ++cc) f[cc] = P[cc][0] * a[0] + P[cc][1] * a[1] + P[cc][2] * a[2];
         }
         double* out[3] = {fx + k * T + t, fy + k * T + t, fz + k * T + t};

@@ -62,7 +62,9 @@ class FiniteStrainForce {
     std::vector<int> point;     // [(n * p + j) * tile + t]: point j of the cell in lane t of tile n
     std::vector<int> dof;       // [(n * m + k) * tile + t]: 3 x node k of that cell
     // Not factored: the gradients.
-    std::vector<double> grad;   // [(((n * p + j) * m + k) * 3 + c) * tile + t]: grad N_k at point j, component c
+    // [((n * p + j) * tile + v) * m * 3 + (k * 3 + c) * kVec + l]: grad N_k at point j, component c,
+    // lane t = v + l (v a multiple of kVec): a vector of lanes reads its points' gradients in one run.
+    std::vector<double> grad;
     // Factored: each cell's basis and the batch's combinations.
     std::vector<double> basis;  // [((n * 3 + b) * 3 + c) * tile + t]: basis vector b, component c
     std::vector<double> coef;   // [(j * m + k) * 3 + b]: grad N_k at point j = sum_b coef B_b
