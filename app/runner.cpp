@@ -77,6 +77,9 @@ std::vector<std::filesystem::path> earlier_fields_files(const std::filesystem::p
 // frames the checkpoint counts.
 class Outputs {
  public:
+  double balance() const { return balance_; }
+  double energy_flow() const { return energy_flow_; }
+  const std::vector<std::pair<std::string, double>>& energy_parts() const { return energy_parts_; }
   // `run`: the run's identity, which tags its fields file (carried over by restarts).
   Outputs(const Scene& scene, std::uint64_t run, const StateArchive* restart, const std::filesystem::path& checkpoint_dir)
       : scene_(scene), run_(run) {
@@ -146,6 +149,11 @@ class Outputs {
         total - verlet + dissipated + e.fracture - external_work - energies.coupling_work - initial_total;
     for (double x : {e.kinetic, e.bond, e.contact, external_work, dissipated, e.fracture, total, balance})
       row_.push_back(x);
+    balance_ = balance;
+    energy_flow_ = std::abs(external_work) + std::abs(energies.coupling_work) + std::abs(dissipated) + std::abs(e.fracture);
+    energy_parts_ = {{"DEM kinetic", e.kinetic}, {"bonds", e.bond}, {"contacts", e.contact}};
+    if (scene_.continuum)
+      energy_parts_.insert(energy_parts_.end(), {{"continuum kinetic", energies.continuum_kinetic}, {"continuum strain", energies.continuum_strain}});
     if (scene_.continuum) {
       row_.push_back(energies.continuum_kinetic);
       row_.push_back(energies.continuum_strain);
@@ -320,6 +328,10 @@ class Outputs {
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
+  // The last row's E_balance, the energy that entered, left or broke (|work|, the coupling's
+  // |work|, dissipated, fractured) and the energies a failed balance names.
+  double balance_ = 0.0, energy_flow_ = 0.0;
+  std::vector<std::pair<std::string, double>> energy_parts_;
   std::string breaks_text_;           // breaks.csv as it will be written
   std::size_t breaks_formatted_ = 0;  // breaks already in breaks_text_
   std::size_t breaks_on_disk_ = 0;    // breaks in the file last written
@@ -452,6 +464,17 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
 
 }  // namespace
 
+std::string unbalanced(double balance, double budget, const std::vector<std::pair<std::string, double>>& parts,
+                       const std::string& likely_cause) {
+  if (!(std::abs(balance) > balance_limit * budget) && std::isfinite(balance)) return {};
+  std::ostringstream msg;
+  msg << "the energy balance is off by " << balance << " J, " << 100.0 * std::abs(balance) / budget << " % of the " << budget
+      << " J that started in, entered, left or broke in the scene (limit " << 100.0 * balance_limit << " %; now";
+  for (std::size_t k = 0; k < parts.size(); ++k) msg << (k ? ", " : " ") << parts[k].first << " " << parts[k].second << " J";
+  msg << "): the run is unstable, however slowly; likely cause: " << likely_cause;
+  return msg.str();
+}
+
 RunResult run_scene(Scene& scene, const RunOptions& options) {
   dem::DemModel& model = scene.dem;
   long total_steps = scene.steps;
@@ -554,6 +577,11 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const auto current_time = [&] { return steps_done * scene.dt; };
   // Outputs are written after step n when it ends on a row or a frame, or is the last.
   const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
+  const std::string likely_cause =
+      std::string(scene.continuum ? "the continuum's force taken once every too many steps (coupling.continuum_substeps: an "
+                                    "impulse method's resonance, docs/theory.md#continuum-substeps), "
+                                  : "") +
+      "a time step too close to the stability limit, or work a boundary condition does not report";
   const auto write_outputs = [&] {
     const auto t0 = Clock::now();
     // A row takes every model's energies (the continuum's strain energy is a pass over it); a
@@ -566,6 +594,16 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     result.energies = energies.dem;
     if (row_due || last) {
       result.sensors = outputs.write_row(current_time(), steps_done, energies, initial_total);
+      // The balance's verdict (after the row, which shows it), for a time loop (a static solve's
+      // balance is its complementary energy): what it is measured against is the blow-up test's
+      // scale (the start's energy, or the round-off floor) and the energy flow.
+      const double start = std::max(energy_scale, round_off * std::pow(current_time() / scene.dt_critical, 2));
+      if (const std::string why = unbalanced(outputs.balance(), start + outputs.energy_flow(), outputs.energy_parts(), likely_cause);
+          !static_only && !why.empty()) {
+        std::ostringstream at;
+        at << "step " << steps_done << " (t = " << current_time() << " s): ";
+        throw RunError(at.str() + why);
+      }
       if (row_due) next_row += scene.output.every, outputs.mark_rows_on_schedule();
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
     }

@@ -64,6 +64,15 @@ struct RunResult {
 
 RunResult run_scene(Scene& scene, const RunOptions& options);
 
+// The energy balance's verdict on a series.csv row (docs/stability.md#energy-balance): empty while
+// |balance| <= balance_limit x budget, else why the run stops. `budget` is the energy that
+// started in, entered, left or broke in the scene (the start's energy or round-off floor, |work|,
+// the coupling's |work|, dissipated, fractured), `parts` the energies the message lists (name, J),
+// `likely_cause` what the message suggests.
+constexpr double balance_limit = 0.25;
+std::string unbalanced(double balance, double budget, const std::vector<std::pair<std::string, double>>& parts,
+                       const std::string& likely_cause);
+
 std::string describe(const Check& check);  // "final value", "maximum over Delta in [0, 0.002]", ...
 // Steps per second of the time loop without its output (summary.json's and the closing line's).
 double steps_per_second(const RunResult& r);

@@ -1193,6 +1193,21 @@ TEST(Runner, UnstableStepStopsTheRunAsABlowUp) {
   EXPECT_EQ(read_json_file(out / "summary.json").at("status").get<std::string>(), "failed");
 }
 
+// The energy balance's verdict on a row (runner.hpp): within a quarter of the energy that
+// started in, entered, left or broke in the scene it says nothing, beyond it (either sign, or not
+// finite) it says why the run stops, naming the energies it lists and the likely cause.
+TEST(Runner, EnergyBalanceBeyondAQuarterOfTheBudgetStopsTheRun) {
+  const std::vector<std::pair<std::string, double>> parts{{"DEM kinetic", 0.5}, {"bonds", 0.25}};
+  EXPECT_EQ(app::unbalanced(0.24, 1.0, parts, "a cause"), "");
+  EXPECT_EQ(app::unbalanced(-0.24, 1.0, parts, "a cause"), "");
+  const std::string msg = app::unbalanced(-0.26, 1.0, parts, "a cause");
+  EXPECT_NE(msg.find("the energy balance is off by -0.26 J, 26 % of the 1 J"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("now DEM kinetic 0.5 J, bonds 0.25 J"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("likely cause: a cause"), std::string::npos) << msg;
+  EXPECT_NE(app::unbalanced(0.26, 1.0, parts, "a cause"), "");
+  EXPECT_NE(app::unbalanced(std::nan(""), 1.0, parts, "a cause"), "");
+}
+
 // Ctrl-C during the time loop: the run stops after the step it is in, closes every output as
 // after a failure (series.csv rows, fields.h5 renamed into place, summary.json "interrupted")
 // and throws Interrupted, which is not a RunError, so sweeps and suites do not carry on.
