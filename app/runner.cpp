@@ -466,7 +466,8 @@ std::vector<RunResult::CheckResult> evaluate_checks(const Scene& scene, const Cs
 
 std::string unbalanced(double balance, double budget, const std::vector<std::pair<std::string, double>>& parts,
                        const std::string& likely_cause) {
-  if (!(std::abs(balance) > balance_limit * budget) && std::isfinite(balance)) return {};
+  // A balance that is not finite is left to the finite check, which names the DE.
+  if (!(std::abs(balance) > balance_limit * budget) || !std::isfinite(balance)) return {};
   std::ostringstream msg;
   msg << "the energy balance is off by " << balance << " J, " << 100.0 * std::abs(balance) / budget << " % of the " << budget
       << " J that started in, entered, left or broke in the scene (limit " << 100.0 * balance_limit << " %; now";

@@ -65,7 +65,8 @@ struct RunResult {
 RunResult run_scene(Scene& scene, const RunOptions& options);
 
 // The energy balance's verdict on a series.csv row (docs/stability.md#energy-balance): empty while
-// |balance| <= balance_limit x budget, else why the run stops. `budget` is the energy that
+// |balance| <= balance_limit x budget or the balance is not finite (the finite check's to name),
+// else why the run stops. `budget` is the energy that
 // started in, entered, left or broke in the scene (the start's energy or round-off floor, |work|,
 // the coupling's |work|, dissipated, fractured), `parts` the energies the message lists (name, J),
 // `likely_cause` what the message suggests.
