@@ -44,6 +44,23 @@ std::pair<double, double> continuum_balance_terms(const Scene& scene) {
   if (!scene.continuum || scene.static_only() || scene.model->monitor()) return {continuum_work(scene), 0.0};
   return {continuum_work(scene), scene.continuum->verlet_correction(scene.dt)};
 }
+// A row's energy balance (docs/theory.md#energy): with a continuum it covers both models and the
+// coupling's work, and W_external the continuum's tractions and supports too
+// (continuum_balance_terms). `flow` is the energy that entered, left or broke (|work|, the
+// coupling's |work|, dissipated, fractured), which the run's verdict measures the balance against.
+struct EnergyBalance {
+  double external_work = 0.0, dissipated = 0.0, balance = 0.0, flow = 0.0;
+};
+EnergyBalance energy_balance(const Scene& scene, const SceneEnergies& energies, double initial_total) {
+  const dem::Energies& e = energies.dem;
+  const auto [continuum_work, verlet] = continuum_balance_terms(scene);
+  EnergyBalance b;
+  b.external_work = e.external_work + continuum_work;
+  b.dissipated = e.dissipated + energies.continuum_dissipated;
+  b.balance = energies.total() - verlet + b.dissipated + e.fracture - b.external_work - energies.coupling_work - initial_total;
+  b.flow = std::abs(b.external_work) + std::abs(energies.coupling_work) + std::abs(b.dissipated) + std::abs(e.fracture);
+  return b;
+}
 // series.csv's header as one text ("time,step,...,"), which a checkpoint holds to be recognised.
 std::string column_list(const std::vector<std::string>& columns) {
   std::string list;
@@ -77,9 +94,6 @@ std::vector<std::filesystem::path> earlier_fields_files(const std::filesystem::p
 // frames the checkpoint counts.
 class Outputs {
  public:
-  double balance() const { return balance_; }
-  double energy_flow() const { return energy_flow_; }
-  const std::vector<std::pair<std::string, double>>& energy_parts() const { return energy_parts_; }
   // `run`: the run's identity, which tags its fields file (carried over by restarts).
   Outputs(const Scene& scene, std::uint64_t run, const StateArchive* restart, const std::filesystem::path& checkpoint_dir)
       : scene_(scene), run_(run) {
@@ -124,9 +138,9 @@ class Outputs {
     archive.put_text("run/frames_index", fields_ ? fields_->frames_index(frames_on_schedule_) : "");
   }
 
-  // One row of series.csv; returns the sensors' values.
+  // One row of series.csv with the row's energy balance; returns the sensors' values.
   std::vector<std::pair<std::string, double>> write_row(double time, long step, const SceneEnergies& energies,
-                                                       double initial_total) {
+                                                       const EnergyBalance& b) {
     row_.assign({time, double(step)});
     std::vector<std::pair<std::string, double>> values;
     const auto names = sensor_columns(scene_);
@@ -139,21 +153,9 @@ class Outputs {
           values.emplace_back(names[column++], v[k]);
         }
     }
-    // With a continuum, E_total and E_balance cover both models (and the coupling's work), and
-    // W_external the continuum's tractions and supports too (continuum_balance_terms).
     const dem::Energies& e = energies.dem;
-    const double total = energies.total();
-    const auto [continuum_work, verlet] = continuum_balance_terms(scene_);
-    const double external_work = e.external_work + continuum_work, dissipated = e.dissipated + energies.continuum_dissipated;
-    const double balance =
-        total - verlet + dissipated + e.fracture - external_work - energies.coupling_work - initial_total;
-    for (double x : {e.kinetic, e.bond, e.contact, external_work, dissipated, e.fracture, total, balance})
+    for (double x : {e.kinetic, e.bond, e.contact, b.external_work, b.dissipated, e.fracture, energies.total(), b.balance})
       row_.push_back(x);
-    balance_ = balance;
-    energy_flow_ = std::abs(external_work) + std::abs(energies.coupling_work) + std::abs(dissipated) + std::abs(e.fracture);
-    energy_parts_ = {{"DEM kinetic", e.kinetic}, {"bonds", e.bond}, {"contacts", e.contact}};
-    if (scene_.continuum)
-      energy_parts_.insert(energy_parts_.end(), {{"continuum kinetic", energies.continuum_kinetic}, {"continuum strain", energies.continuum_strain}});
     if (scene_.continuum) {
       row_.push_back(energies.continuum_kinetic);
       row_.push_back(energies.continuum_strain);
@@ -328,10 +330,6 @@ class Outputs {
   std::optional<CsvSeries> series_;
   std::optional<FieldsWriter> fields_;
   std::vector<double> row_;
-  // The last row's E_balance, the energy that entered, left or broke (|work|, the coupling's
-  // |work|, dissipated, fractured) and the energies a failed balance names.
-  double balance_ = 0.0, energy_flow_ = 0.0;
-  std::vector<std::pair<std::string, double>> energy_parts_;
   std::string breaks_text_;           // breaks.csv as it will be written
   std::size_t breaks_formatted_ = 0;  // breaks already in breaks_text_
   std::size_t breaks_on_disk_ = 0;    // breaks in the file last written
@@ -594,16 +592,22 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     const SceneEnergies energies = row_due || last ? scene.model->energies() : SceneEnergies{model.energies()};
     result.energies = energies.dem;
     if (row_due || last) {
-      result.sensors = outputs.write_row(current_time(), steps_done, energies, initial_total);
+      const EnergyBalance balance = energy_balance(scene, energies, initial_total);
+      result.sensors = outputs.write_row(current_time(), steps_done, energies, balance);
       // The balance's verdict (after the row, which shows it), for a time loop (a static solve's
       // balance is its complementary energy): what it is measured against is the blow-up test's
       // scale (the start's energy, or the round-off floor) and the energy flow.
-      const double start = std::max(energy_scale, round_off * std::pow(current_time() / scene.dt_critical, 2));
-      if (const std::string why = unbalanced(outputs.balance(), start + outputs.energy_flow(), outputs.energy_parts(), likely_cause);
-          !static_only && !why.empty()) {
-        std::ostringstream at;
-        at << "step " << steps_done << " (t = " << current_time() << " s): ";
-        throw RunError(at.str() + why);
+      if (!static_only) {
+        const double start = std::max(energy_scale, round_off * std::pow(current_time() / scene.dt_critical, 2));
+        const dem::Energies& e = energies.dem;
+        std::vector<std::pair<std::string, double>> parts{{"DEM kinetic", e.kinetic}, {"bonds", e.bond}, {"contacts", e.contact}};
+        if (scene.continuum)
+          parts.insert(parts.end(), {{"continuum kinetic", energies.continuum_kinetic}, {"continuum strain", energies.continuum_strain}});
+        if (const std::string why = unbalanced(balance.balance, start + balance.flow, parts, likely_cause); !why.empty()) {
+          std::ostringstream at;
+          at << "step " << steps_done << " (t = " << current_time() << " s): ";
+          throw RunError(at.str() + why);
+        }
       }
       if (row_due) next_row += scene.output.every, outputs.mark_rows_on_schedule();
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
