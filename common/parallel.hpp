@@ -45,6 +45,43 @@ inline int thread_index() {
 #endif
 }
 
+// The number of threads in the calling thread's team (1 outside a parallel region).
+inline int team_size() {
+#ifdef _OPENMP
+  return omp_get_num_threads();
+#else
+  return 1;
+#endif
+}
+
+// Loops over the DEs split them in whole chunks of this many, the same chunks for every loop:
+// small enough that a 10k-DE scene gives 16 threads ten chunks each (shares within a tenth of
+// each other), large enough that a chunk of a per-DE vector array spans whole cache lines but
+// at its two ends.
+inline constexpr long share_chunk = 64;
+
+struct IndexRange {
+  long begin = 0, end = 0;
+};
+
+// The calling thread's share of `chunks` chunks: thread t of a team of T takes
+// [t C / T, (t + 1) C / T). Every loop over the DEs (kicks, drift, clearing the forces, damping,
+// the finite check, the beam sets' per-DE sums and their bonds' kernel pass) splits by this rule,
+// so a thread works on the same DEs in every phase and their data stay in its core's cache; a
+// split of each loop by its own index set (OpenMP's static schedule over DEs, over chunks of
+// DEs, over a bond set's own DEs) moves the DEs near every boundary from core to core at each
+// phase (docs/performance.md#one-owner). Outside a parallel region: all of them.
+inline IndexRange chunk_share(long chunks) {
+  const long threads = team_size(), t = thread_index();
+  return {chunks * t / threads, chunks * (t + 1) / threads};
+}
+
+// The calling thread's share of the items [0, n), in whole chunks of share_chunk (chunk_share).
+inline IndexRange thread_share(long n) {
+  const IndexRange c = chunk_share((n + share_chunk - 1) / share_chunk);
+  return {std::min(n, c.begin * share_chunk), std::min(n, c.end * share_chunk)};
+}
+
 // Whether a loop asked to run `threaded` does run on more than one thread.
 inline bool runs_threaded(bool threaded) {
   return threaded && max_threads() > 1;
@@ -70,27 +107,29 @@ void run_threaded_if(bool threaded, Loop&& loop) {
   loop();
 }
 
-// body(i) for i in [0, n), split statically over the OpenMP threads if `threaded`.
+// body(i) for i in [0, n), split over the OpenMP threads by thread_share if `threaded`.
 template <class Body>
 void for_each_index(long n, bool threaded, Body&& body) {
   run_threaded_if(threaded, [n, &body] {
-#pragma omp for schedule(static)
-    for (long i = 0; i < n; ++i) body(i);
+    const IndexRange share = thread_share(n);
+    for (long i = share.begin; i < share.end; ++i) body(i);
   });
 }
 
-// Items [0, n) in fixed chunks of 256: partial[c] = scan(begin, end) for chunk c, on the
-// threads when n > threshold; returns the number of chunks. A caller that takes partial[0],
-// partial[1], ... in order gets a result with the same bits on any thread count (an OpenMP
-// reduction's does not). `partial` grows once and is reused (no allocation per call). The chunk
-// is small enough that a scene just above the threshold (the 10k REV) gives 16 threads several
-// chunks each.
+// Items [0, n) in fixed chunks of share_chunk: partial[c] = scan(begin, end) for chunk c, on the
+// threads when n > threshold, each thread its chunk_share; returns the number of chunks. A
+// caller that takes partial[0], partial[1], ... in order gets a result with the same bits on any
+// thread count (an OpenMP reduction's does not). `partial` grows once and is reused (no
+// allocation per call).
 template <class T, class Scan>
 long scan_fixed_chunks(long n, long threshold, std::vector<T>& partial, Scan&& scan) {
-  constexpr long chunk = 256;
+  constexpr long chunk = share_chunk;
   const long chunks = (n + chunk - 1) / chunk;
   if (static_cast<long>(partial.size()) < chunks) partial.resize(static_cast<std::size_t>(chunks));
-  for_each_index(chunks, n > threshold, [&](long c) { partial[static_cast<std::size_t>(c)] = scan(c * chunk, std::min(n, (c + 1) * chunk)); });
+  run_threaded_if(n > threshold, [&] {
+    const IndexRange share = chunk_share(chunks);
+    for (long c = share.begin; c < share.end; ++c) partial[static_cast<std::size_t>(c)] = scan(c * chunk, std::min(n, (c + 1) * chunk));
+  });
   return chunks;
 }
 

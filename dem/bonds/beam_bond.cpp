@@ -334,12 +334,19 @@ void BeamBondSet::finalize(std::size_t n_particles) {
 void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
   const Records r = records(scan);
   const long bonds = static_cast<long>(size());
-  const long n = static_cast<long>(bonded_.size());
   if (end_offsets_.empty()) throw std::logic_error("BeamBondSet: a force pass before finalize()");
   run_threaded_if(colouring_.threaded, [&] {
+    // A thread takes the DEs every per-DE loop gives it (thread_share), the bonds whose first DE
+    // is one of them (the boundaries rounded down to whole blocks) and, in the sums, those DEs.
+    const long n_particles = static_cast<long>(p.size());
+    const IndexRange des = thread_share(n_particles);
+    const auto first_bond_of = [this](long i) {
+      return (std::lower_bound(first_.begin(), first_.end(), static_cast<std::uint32_t>(i)) - first_.begin()) / long(block) * long(block);
+    };
+    const long bond_begin = des.begin == 0 ? 0 : first_bond_of(des.begin);
+    const long bond_end = des.end == n_particles ? bonds : first_bond_of(des.end);
     // Every bond's actions (and its failure measure or energy), a block at a time, stored whole.
-#pragma omp for schedule(static)
-    for (long first = 0; first < bonds; first += long(block)) {
+    for (long first = bond_begin; first < bond_end; first += long(block)) {
       ActionsBlock a;
       const std::size_t count = std::min<std::size_t>(block, std::size_t(bonds - first));
       actions(std::size_t(first), count, p, a, r.criterion);
@@ -358,16 +365,20 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
       if (r.energy)
         for (std::size_t l = 0; l < count; ++l) energy_record_[first + l] = energy_of(first + l, a[l]);
     }
-    // Every bonded DE adds its bonds' actions in bond order (-f on a first DE, +f on a second),
-    // split over the threads in DE order as the kicks. Raw pointers: nothing in the loop can
-    // move the arrays, and the compiler keeps them in registers.
+#pragma omp barrier
+    // Every bonded DE adds its bonds' actions in bond order (-f on a first DE, +f on a second).
+    // Raw pointers: nothing in the loop can move the arrays, and the compiler keeps them in
+    // registers.
     const double *fx = bond_actions_[0].data(), *fy = bond_actions_[1].data(), *fz = bond_actions_[2].data();
     const double *tix = bond_actions_[3].data(), *tiy = bond_actions_[4].data(), *tiz = bond_actions_[5].data();
     const double *tjx = bond_actions_[6].data(), *tjy = bond_actions_[7].data(), *tjz = bond_actions_[8].data();
     const std::uint32_t *bonded = bonded_.data(), *offsets = end_offsets_.data(), *ends = end_bonds_.data();
     Vec3 *force = p.force.data(), *torque = p.torque.data();
-#pragma omp for schedule(static) nowait
-    for (long k = 0; k < n; ++k) {
+    const auto bonded_at = [this](long i) {
+      return std::lower_bound(bonded_.begin(), bonded_.end(), static_cast<std::uint32_t>(i)) - bonded_.begin();
+    };
+    const long k_begin = bonded_at(des.begin), k_end = bonded_at(des.end);
+    for (long k = k_begin; k < k_end; ++k) {
       Vec3 f{}, t{};
       for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
         const std::uint32_t b = ends[e] >> 1;
@@ -384,8 +395,7 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
     }
     if (!r.virial) return;
     // Recording the virial (RDEF): each DE's intact bonds' terms, in bond order, as accumulate_virial.
-#pragma omp for schedule(static)
-    for (long k = 0; k < n; ++k)
+    for (long k = k_begin; k < k_end; ++k)
       for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
         const std::uint32_t b = ends[e] >> 1;
         if (!broken_[b])
