@@ -133,6 +133,24 @@ long scan_fixed_chunks(long n, long threshold, std::vector<T>& partial, Scan&& s
   return chunks;
 }
 
+// partial[t] = scan(begin, end) over thread t's share (thread_share) of the items [0, n), on the
+// threads when n > threshold; returns the number of shares, whose partials the caller combines.
+// For reductions whose result does not depend on how the items are grouped (a largest value,
+// whether any item is not finite): one partial per thread instead of one per chunk. Sums, whose
+// round-off does, go through scan_fixed_chunks. A share no thread took keeps T{}, which must be
+// the reduction's identity.
+template <class T, class Scan>
+long scan_thread_shares(long n, long threshold, std::vector<T>& partial, Scan&& scan) {
+  const long shares = runs_threaded(n > threshold) ? max_threads() : 1;
+  if (static_cast<long>(partial.size()) < shares) partial.resize(static_cast<std::size_t>(shares));
+  std::fill(partial.begin(), partial.begin() + shares, T{});
+  run_threaded_if(n > threshold, [&] {
+    const IndexRange share = thread_share(n);
+    partial[static_cast<std::size_t>(thread_index())] = scan(share.begin, share.end);
+  });
+  return shares;
+}
+
 // sum over i < n of term(i), each term evaluated once (it may update state of item i): the
 // chunks of scan_fixed_chunks summed, then their sums added in order (the half kicks of a damped
 // scene run through here).

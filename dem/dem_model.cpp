@@ -568,7 +568,7 @@ void DemModel::check_finite() const {
   const ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
   const PhaseTimer timer(profile_, phase_.finite, particle_loops_threaded());
-  // Chunks of DEs on the threads, split as the kicks, each a vectorised pass that only finds
+  // Each thread's share of the DEs (split as the kicks) in a vectorised pass that only finds
   // whether a velocity is not finite (x - x is 0 for a finite x, NaN otherwise; a sum of them is
   // NaN if any is) and, with contact, the largest |v|^2 / R^2 and frequency bound: maxima and
   // that test do not depend on the order of the terms. Only when the step fails a check does
@@ -583,7 +583,7 @@ void DemModel::check_finite() const {
   const auto probe_of = [v, w](long i) {
     return ((v[i].x - v[i].x) + (v[i].y - v[i].y) + (v[i].z - v[i].z)) + ((w[i].x - w[i].x) + (w[i].y - w[i].y) + (w[i].z - w[i].z));
   };
-  const long chunks = scan_fixed_chunks(n, parallel_threshold, finite_chunks_, [&](long begin, long end) {
+  const long shares = scan_thread_shares(n, parallel_threshold, finite_shares_, [&](long begin, long end) {
     double probe = 0.0, reach2 = 0.0, omega2 = 0.0;
     if (contact) {
 #pragma omp simd reduction(+ : probe) reduction(max : reach2, omega2)
@@ -599,8 +599,8 @@ void DemModel::check_finite() const {
     return FiniteScan{!(probe == 0.0), reach2, omega2};
   });
   FiniteScan all;
-  for (long c = 0; c < chunks; ++c) {
-    const FiniteScan& scan = finite_chunks_[static_cast<std::size_t>(c)];
+  for (long t = 0; t < shares; ++t) {
+    const FiniteScan& scan = finite_shares_[static_cast<std::size_t>(t)];
     all.bad = all.bad || scan.bad;
     all.reach2 = std::max(all.reach2, scan.reach2);
     all.omega2 = std::max(all.omega2, scan.omega2);

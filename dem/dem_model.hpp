@@ -232,12 +232,12 @@ class DemModel {
   std::vector<BreakEvent> breaks_;
   std::vector<BreakEvent> new_breaks_;   // scratch, this step's candidates
   std::vector<double> kick_partial_;     // scratch: kick's chunk sums of the damping work
-  struct FiniteScan {  // check_finite's pass over a chunk of DEs
+  struct FiniteScan {  // check_finite's pass over a thread's DEs
     bool bad = false;     // a non-finite velocity
     double reach2 = 0.0;  // the largest |v|^2 / R^2, 1/s^2
     double omega2 = 0.0;  // the largest frequency bound with the contacts touching now, 1/s^2
   };
-  mutable std::vector<FiniteScan> finite_chunks_;  // scratch: check_finite's chunks
+  mutable std::vector<FiniteScan> finite_shares_;  // scratch: check_finite's, one per thread
   bool energy_record_requested_ = false;  // record_energies_in_next_step()
   long energy_record_step_ = -1;          // the step whose force pass recorded the bonds' energies
   mutable std::vector<double> bond_energy_share_;  // scratch of group_energy(), J per DE

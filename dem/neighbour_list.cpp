@@ -83,17 +83,40 @@ void NeighbourList::build(const ParticleSet& p) {
   scratch_next_.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     if (p.radius[i] <= large) cell_des_[scratch_next_[cell_of_de_[i]]++] = static_cast<std::uint32_t>(i);
-  // The pair (i, j), i < j, if within reach and not excluded.
-  const auto consider = [&](std::uint32_t a, std::uint32_t b, std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
-    const double reach = p.radius[a] + p.radius[b] + skin_;
-    if (norm2(p.position[b] - p.position[a]) >= reach * reach) return;
+  // The binned DEs' positions and radii in cell order: a cell's candidates are read as runs of
+  // consecutive entries, not one cache line each through the DE index.
+  binned_position_.resize(cell_des_.size());
+  binned_radius_.resize(cell_des_.size());
+  for (std::size_t k = 0; k < cell_des_.size(); ++k) {
+    binned_position_[k] = p.position[cell_des_[k]];
+    binned_radius_[k] = p.radius[cell_des_[k]];
+  }
+  using PairList = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+  // The pair (a, b) of DEs, as (i, j) with i < j, unless excluded.
+  const auto add_unless_excluded = [&](std::uint32_t a, std::uint32_t b, PairList& out) {
     const std::uint32_t i = std::min(a, b), j = std::max(a, b);
     for (std::uint32_t k = excluded_start_[i]; k < excluded_start_[i + 1]; ++k)
       if (static_cast<std::uint32_t>(excluded_[k]) == j) return;
     out.emplace_back(i, j);
   };
-  // Each cell against itself and the neighbours after it in cell order: every pair of cells
-  // once. On threads each collects its own pairs, in an order that depends on the threads.
+  // The pair (a, b) if within reach and not excluded.
+  const auto consider = [&](std::uint32_t a, std::uint32_t b, PairList& out) {
+    const double reach = p.radius[a] + p.radius[b] + skin_;
+    if (norm2(p.position[b] - p.position[a]) < reach * reach) add_unless_excluded(a, b, out);
+  };
+  // Binned entry a against the binned entries [from, to): the same test as consider's.
+  const auto consider_run = [&](std::uint32_t a, std::uint32_t from, std::uint32_t to, PairList& out) {
+    const Vec3 xa = binned_position_[a];
+    const double ra = binned_radius_[a];
+    for (std::uint32_t b = from; b < to; ++b) {
+      const double reach = ra + binned_radius_[b] + skin_;
+      if (norm2(binned_position_[b] - xa) < reach * reach) add_unless_excluded(cell_des_[a], cell_des_[b], out);
+    }
+  };
+  // Each cell against itself and the 13 neighbours after it in cell order (every pair of cells
+  // once): the next cell along z, and four columns of up to three cells, each column's cells
+  // consecutive in cell order, so its DEs one run. On threads each collects its own pairs, in an
+  // order that depends on the threads.
   const std::int64_t cells = nx * ny * nz;
   const bool threaded = static_cast<long>(n) > parallel_threshold;
   const auto teams = static_cast<std::size_t>(runs_threaded(threaded) ? max_threads() : 1);
@@ -103,25 +126,28 @@ void NeighbourList::build(const ParticleSet& p) {
     for (std::uint32_t j = 0; j < n; ++j)
       if (p.radius[j] <= large || j > i) consider(i, j, found_[0]);
   run_threaded_if(threaded, [&] {
-    std::vector<std::pair<std::uint32_t, std::uint32_t>>& out = found_[static_cast<std::size_t>(thread_index())];
+    PairList& out = found_[static_cast<std::size_t>(thread_index())];
 #pragma omp for schedule(dynamic, 256)
     for (std::int64_t c = 0; c < cells; ++c) {
-      const std::uint32_t* begin = cell_des_.data() + cell_start_[c];
-      const std::uint32_t* end = cell_des_.data() + cell_start_[c + 1];
+      const std::uint32_t begin = cell_start_[c], end = cell_start_[c + 1];
       if (begin == end) continue;  // most cells of a sparse scene
       const std::int64_t cx = c / (ny * nz), cy = c / nz % ny, cz = c % nz;
-      for (const std::uint32_t* a = begin; a != end; ++a)
-        for (const std::uint32_t* b = a + 1; b != end; ++b) consider(*a, *b, out);
-      for (std::int64_t dx = -1; dx <= 1; ++dx)
-        for (std::int64_t dy = -1; dy <= 1; ++dy)
-          for (std::int64_t dz = -1; dz <= 1; ++dz) {
-            const std::int64_t ox = cx + dx, oy = cy + dy, oz = cz + dz;
-            if (ox < 0 || oy < 0 || oz < 0 || ox >= nx || oy >= ny || oz >= nz) continue;
-            const std::int64_t other = (ox * ny + oy) * nz + oz;
-            if (other <= c) continue;
-            for (const std::uint32_t* a = begin; a != end; ++a)
-              for (std::uint32_t k = cell_start_[other]; k < cell_start_[other + 1]; ++k) consider(*a, cell_des_[k], out);
-          }
+      // The runs of binned entries this cell's DEs meet: the next cell along z, then the columns
+      // (cx, cy + 1), (cx + 1, cy - 1 ... cy + 1), each from cz - 1 to cz + 1.
+      std::uint32_t run_from[5], run_to[5];
+      int runs = 0;
+      if (cz + 1 < nz) run_from[runs] = end, run_to[runs++] = cell_start_[c + 2];
+      const std::int64_t z0 = std::max<std::int64_t>(cz - 1, 0), z1 = std::min<std::int64_t>(cz + 1, nz - 1);
+      for (const auto& [dx, dy] : {std::pair{0, 1}, std::pair{1, -1}, std::pair{1, 0}, std::pair{1, 1}}) {
+        const std::int64_t ox = cx + dx, oy = cy + dy;
+        if (ox >= nx || oy < 0 || oy >= ny) continue;
+        const std::int64_t column = (ox * ny + oy) * nz;
+        run_from[runs] = cell_start_[column + z0], run_to[runs++] = cell_start_[column + z1 + 1];
+      }
+      for (std::uint32_t a = begin; a != end; ++a) {
+        consider_run(a, a + 1, end, out);
+        for (int r = 0; r < runs; ++r) consider_run(a, run_from[r], run_to[r], out);
+      }
     }
   });
   // The list sorted by (i, j), so the same whatever thread found a pair: a counting sort by i,
@@ -149,8 +175,9 @@ double NeighbourList::large_radius(std::span<const double> radii, std::vector<do
 bool NeighbourList::needs_rebuild(const ParticleSet& p) const {
   if (position_at_build_.size() != p.size()) return true;
   // A pair left out had a gap of at least the skin at the build; since then it closed by at most
-  // the sum of the two DEs' displacements, so at most the sum of the two largest. Chunk by chunk
-  // on the threads; the two largest of all do not depend on the order they are met in.
+  // the sum of the two DEs' displacements, so at most the sum of the two largest. Each thread's
+  // share of the DEs on the threads; the two largest of all do not depend on the order they are
+  // met in.
   using Largest = std::pair<double, double>;  // the two largest squared displacements
   const auto add = [](Largest& top, double d2) {
     if (d2 > top.first) {
@@ -160,15 +187,15 @@ bool NeighbourList::needs_rebuild(const ParticleSet& p) const {
       top.second = d2;
     }
   };
-  const long chunks = scan_fixed_chunks(static_cast<long>(p.size()), parallel_threshold, largest_moves_, [&](long begin, long end) {
+  const long shares = scan_thread_shares(static_cast<long>(p.size()), parallel_threshold, largest_moves_, [&](long begin, long end) {
     Largest top{0.0, 0.0};
     for (long i = begin; i < end; ++i) add(top, norm2(p.position[static_cast<std::size_t>(i)] - position_at_build_[static_cast<std::size_t>(i)]));
     return top;
   });
   Largest top{0.0, 0.0};
-  for (long c = 0; c < chunks; ++c) {
-    add(top, largest_moves_[static_cast<std::size_t>(c)].first);
-    add(top, largest_moves_[static_cast<std::size_t>(c)].second);
+  for (long t = 0; t < shares; ++t) {
+    add(top, largest_moves_[static_cast<std::size_t>(t)].first);
+    add(top, largest_moves_[static_cast<std::size_t>(t)].second);
   }
   return std::sqrt(top.first) + std::sqrt(top.second) > skin_;
 }

@@ -52,9 +52,11 @@ class NeighbourList {
   std::vector<std::uint32_t> cell_des_;    // the binned DEs, by cell, then index
   std::vector<std::uint32_t> scratch_next_;
   std::vector<std::uint32_t> cell_of_de_;  // build's: each binned DE's cell
+  std::vector<Vec3> binned_position_;      // build's: cell_des_'s positions and radii, in its order
+  std::vector<double> binned_radius_;
   std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found_;  // build's pairs, per thread
   std::vector<std::uint32_t> first_start_;  // build's: per DE, where its pairs (as the first) begin
-  mutable std::vector<std::pair<double, double>> largest_moves_;  // needs_rebuild's, per chunk
+  mutable std::vector<std::pair<double, double>> largest_moves_;  // needs_rebuild's, per thread
   std::vector<std::uint32_t> large_;   // DEs kept out of the cells (build's scratch)
   std::vector<double> scratch_radius_;  // build's scratch, for the median radius
   std::size_t builds_ = 0;
