@@ -287,10 +287,13 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
 // is one draw (docs/decisions.md#d43), so the bounds are asserted on the medians of seven
 // pairs (`arlequin compare --ensemble 7`, d44; about 5 and 8 minutes): the sphere's velocity
 // history within 5 % (max over the 100 us of the difference relative to its largest value:
-// measured 3.67 % with fe, the pairs 1.71 to 5.99 %, and 3.81 % with nem, the pure run against
-// itself up to 2.27 %), the peak impact force within 10 % (measured -6.11 % and -9.78 %, rows
-// every 0.1 us), the first break within 10 % (measured -0.01 % and -0.78 %); and without breakage
-// the coupled balance within 1 % of the impact energy (measured 2.5e-4 with fe, 2.3e-4 with nem).
+// measured 3.28 % with fe, the pairs 2.59 to 5.35 %, and 3.22 % with nem, the pure run against
+// itself up to 2.27 %), the peak impact force within 10 % (rows every 0.1 us; measured -10.47 %
+// with fe and -10.28 % with nem, so this test fails: the coupled step's round-off changed with
+// the plate's force and the multiplier solve reworked since the gate was set beside -6.11 % and
+// -9.78 %, and the ensembles with it; the pure run's own peak spreads over -2.9 to +7.5 %,
+// cases/fabric_impact_coupled/README.md), the first break within 10 % (measured -1.53 % and
+// -2.51 %); and without breakage the coupled balance within 1 % of the impact energy.
 TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
