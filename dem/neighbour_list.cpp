@@ -99,19 +99,21 @@ void NeighbourList::build(const ParticleSet& p) {
       if (static_cast<std::uint32_t>(excluded_[k]) == j) return;
     out.emplace_back(i, j);
   };
+  // Whether two spheres' surfaces are closer than the skin.
+  const auto within_reach = [this](const Vec3& xa, double ra, const Vec3& xb, double rb) {
+    const double reach = ra + rb + skin_;
+    return norm2(xb - xa) < reach * reach;
+  };
   // The pair (a, b) if within reach and not excluded.
   const auto consider = [&](std::uint32_t a, std::uint32_t b, PairList& out) {
-    const double reach = p.radius[a] + p.radius[b] + skin_;
-    if (norm2(p.position[b] - p.position[a]) < reach * reach) add_unless_excluded(a, b, out);
+    if (within_reach(p.position[a], p.radius[a], p.position[b], p.radius[b])) add_unless_excluded(a, b, out);
   };
-  // Binned entry a against the binned entries [from, to): the same test as consider's.
+  // Binned entry a against the binned entries [from, to).
   const auto consider_run = [&](std::uint32_t a, std::uint32_t from, std::uint32_t to, PairList& out) {
     const Vec3 xa = binned_position_[a];
     const double ra = binned_radius_[a];
-    for (std::uint32_t b = from; b < to; ++b) {
-      const double reach = ra + binned_radius_[b] + skin_;
-      if (norm2(binned_position_[b] - xa) < reach * reach) add_unless_excluded(cell_des_[a], cell_des_[b], out);
-    }
+    for (std::uint32_t b = from; b < to; ++b)
+      if (within_reach(xa, ra, binned_position_[b], binned_radius_[b])) add_unless_excluded(cell_des_[a], cell_des_[b], out);
   };
   // Each cell against itself and the 13 neighbours after it in cell order (every pair of cells
   // once): the next cell along z, and four columns of up to three cells, each column's cells

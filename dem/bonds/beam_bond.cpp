@@ -340,11 +340,12 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
     // is one of them (the boundaries rounded down to whole blocks) and, in the sums, those DEs.
     const long n_particles = static_cast<long>(p.size());
     const IndexRange des = thread_share(n_particles);
-    const auto first_bond_of = [this](long i) {
-      return (std::lower_bound(first_.begin(), first_.end(), static_cast<std::uint32_t>(i)) - first_.begin()) / long(block) * long(block);
+    // Where DE i's entries begin in a list sorted by DE (first_, bonded_).
+    const auto entries_from = [](const std::vector<std::uint32_t>& by_de, long i) {
+      return static_cast<long>(std::lower_bound(by_de.begin(), by_de.end(), static_cast<std::uint32_t>(i)) - by_de.begin());
     };
-    const long bond_begin = des.begin == 0 ? 0 : first_bond_of(des.begin);
-    const long bond_end = des.end == n_particles ? bonds : first_bond_of(des.end);
+    const long bond_begin = entries_from(first_, des.begin) / long(block) * long(block);
+    const long bond_end = des.end == n_particles ? bonds : entries_from(first_, des.end) / long(block) * long(block);
     // Every bond's actions (and its failure measure or energy), a block at a time, stored whole.
     for (long first = bond_begin; first < bond_end; first += long(block)) {
       ActionsBlock a;
@@ -374,10 +375,7 @@ void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const
     const double *tjx = bond_actions_[6].data(), *tjy = bond_actions_[7].data(), *tjz = bond_actions_[8].data();
     const std::uint32_t *bonded = bonded_.data(), *offsets = end_offsets_.data(), *ends = end_bonds_.data();
     Vec3 *force = p.force.data(), *torque = p.torque.data();
-    const auto bonded_at = [this](long i) {
-      return std::lower_bound(bonded_.begin(), bonded_.end(), static_cast<std::uint32_t>(i)) - bonded_.begin();
-    };
-    const long k_begin = bonded_at(des.begin), k_end = bonded_at(des.end);
+    const long k_begin = entries_from(bonded_, des.begin), k_end = entries_from(bonded_, des.end);
     for (long k = k_begin; k < k_end; ++k) {
       Vec3 f{}, t{};
       for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
