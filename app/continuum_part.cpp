@@ -93,6 +93,8 @@ constexpr KeyDoc coupling_keys[] = {
 };
 constexpr KeyDoc overlap_keys[] = {
     {"shell", KeyType::section, "", {}, "(none)", "the space between two boxes, the DEM inside (instead of a region)"},
+    {"shells", KeyType::list, "", {}, "(none)",
+     "a union of shells, the DEM inside any inner box (a cross of bands; instead of a region; at most 4)"},
     {"band", KeyType::section, "", {}, "(none)", "a DEM band through a continuum, the overlap on its faces (instead of a region)"},
     {"axis", KeyType::choice, "", {}, "", "box: the axis across the overlap", "x | y | z"},
     {"dem_side", KeyType::choice, "", {}, "", "which side of the overlap is the pure-DEM zone",
@@ -124,6 +126,7 @@ constexpr SchemaSection continuum_sections[] = {
     {"coupling.overlap", "the overlap (also the keys of region)", overlap_keys},
     {"coupling.ties[]", "a DE group tied along some components only", tie_keys},
     {"coupling.overlap.shell", "a shell overlap", shell_keys},
+    {"coupling.overlap.shells[]", "a shell of a union of shells", shell_keys},
     {"coupling.overlap.band", "a band overlap: the shell of a slab, DEM inside, across all of the third direction", band_keys},
 };
 
@@ -279,13 +282,25 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
   static constexpr std::string_view axes[] = {"x", "y", "z"};
   static constexpr std::string_view box_sides[] = {"lower", "upper"};
   static constexpr std::string_view cylinder_sides[] = {"base", "top"};
-  if (overlap.has("shell")) {
-    CaseNode shell = overlap.child("shell");
+  const auto read_shell = [](CaseNode shell) {
     const auto inner = shell.vec3_list("inner", Range::any(), "m"), outer = shell.vec3_list("outer", Range::any(), "m");
-    if (inner.size() != 2 || outer.size() != 2) shell.fail("inner", "expected two boxes [[x0,y0,z0],[x1,y1,z1]]");
+    if (inner.size() != 2) shell.fail("inner", "expected two corners [[x0,y0,z0],[x1,y1,z1]]");
+    if (outer.size() != 2) shell.fail("outer", "expected two corners [[x0,y0,z0],[x1,y1,z1]]");
     shell.finish();
+    return std::make_pair(Box{inner[0], inner[1]}, Box{outer[0], outer[1]});
+  };
+  if (overlap.has("shell")) {
+    const auto [inner, outer] = read_shell(overlap.child("shell"));
     overlap.finish();
-    return coupling::OverlapZone::shell(Box{inner[0], inner[1]}, Box{outer[0], outer[1]}, weighting);
+    return coupling::OverlapZone::shell(inner, outer, weighting);
+  }
+  if (overlap.has("shells")) {
+    std::vector<std::pair<Box, Box>> shells;
+    for (CaseNode shell : overlap.list_or_empty("shells")) shells.push_back(read_shell(shell));
+    if (shells.empty() || shells.size() > static_cast<std::size_t>(coupling::OverlapZone::kMaxShells))
+      overlap.fail("shells", "expected 1 to " + std::to_string(coupling::OverlapZone::kMaxShells) + " shells {inner, outer}");
+    overlap.finish();
+    return coupling::OverlapZone::shells(shells, weighting);
   }
   if (overlap.has("band")) {
     // The shell of the slab |x[axis] - center| <= half_thickness, from <= x[along] <= to: the DEM
@@ -321,7 +336,7 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
     overlap.finish();
     return coupling::OverlapZone::cylinder(*cylinder, base, weighting);
   }
-  overlap.fail("box", "an overlap is a box, a cylinder or a shell");
+  overlap.fail("box", "an overlap is a box, a cylinder, a shell, shells or a band");
 }
 
 
@@ -423,7 +438,7 @@ class Part final : public ContinuumPart {
     if (coupling) {
       coupling_ = std::move(coupling);
       const coupling::OverlapZone& zone = coupling_->zone;
-      settings.solver.mesh.left_out = [zone](const Vec3& x) { return zone.in_pure_dem_zone(x); };
+      settings.solver.mesh.left_out = [zone](const std::array<Vec3, 4>& v) { return zone.hull_in_pure_dem_zone(v); };
       settings.solver.mesh.left_out_name =
           "the pure-DEM zone of coupling.overlap (" + coupling_->node.where("overlap") + ": " + zone.description() + ")";
     }

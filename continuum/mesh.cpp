@@ -94,7 +94,7 @@ void refuse_if_gmsh_crashes_on(const std::string& path) {
 }
 
 // MeshSource::left_out on the raw arrays; returns the number of tetrahedra dropped.
-int leave_out(int npe, const std::function<bool(const Vec3&)>& left_out, std::vector<Vec3>& nodes,
+int leave_out(int npe, const std::function<bool(const std::array<Vec3, 4>&)>& left_out, std::vector<Vec3>& nodes,
               std::vector<int>& tets, std::vector<PhysicalGroup>& groups) {
   const int ntet = static_cast<int>(tets.size()) / npe;
   std::vector<int> new_tet(ntet, -1), new_node(nodes.size(), -1);
@@ -102,7 +102,7 @@ int leave_out(int npe, const std::function<bool(const Vec3&)>& left_out, std::ve
   std::vector<Vec3> kept_nodes;
   for (int e = 0; e < ntet; ++e) {
     const int* t = tets.data() + static_cast<std::size_t>(e) * npe;
-    if (std::all_of(t, t + 4, [&](int n) { return left_out(nodes[n]); })) continue;
+    if (left_out({nodes[t[0]], nodes[t[1]], nodes[t[2]], nodes[t[3]]})) continue;
     new_tet[e] = static_cast<int>(kept_tets.size()) / npe;
     for (int k = 0; k < npe; ++k) {
       if (new_node[t[k]] < 0) {

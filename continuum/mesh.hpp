@@ -6,8 +6,9 @@
 //  - Tetrahedra are stored with positive volume, vertices first; quadratic tetrahedra are
 //    renumbered to the fixed edge order of `kTetEdges` (gmsh's own order is not assumed: every
 //    edge node is matched to the midpoint of its two vertices, which also rejects curved P2).
-//  - `MeshSource::left_out` (optional) drops every tetrahedron whose vertices all satisfy it
-//    (an Arlequin coupling's pure-DEM zone), then the nodes only those used; physical groups
+//  - `MeshSource::left_out` (optional) drops every tetrahedron it holds for, given its four
+//    vertices (an Arlequin coupling's pure-DEM zone: whether the tetrahedron lies in it, which for
+//    a convex zone is whether its vertices do), then the nodes only those used; physical groups
 //    keep what remains of them, and a group with nothing left is dropped.
 //  - Problems are InputError: unreadable file, no tetrahedra, inverted or flat tetrahedron,
 //    empty physical group, unknown group name (the message lists the known ones).
@@ -25,7 +26,7 @@ struct MeshSource {
   std::string path;   // .geo (meshed here) or .msh
   double size = 0.0;  // target element size for .geo; 0 keeps the sizes written in the file
   int order = 1;      // 1 or 2, for .geo
-  std::function<bool(const Vec3&)> left_out;  // optional: see the contract
+  std::function<bool(const std::array<Vec3, 4>&)> left_out;  // optional, on a tetrahedron's vertices: see the contract
   std::string left_out_name = "the left-out region";  // for the error when it holds everything
 };
 

@@ -57,6 +57,31 @@ double frobenius(const Matrix3& m) { return m.size() ? m.norm() : 0.0; }
 
 }  // namespace
 
+// A row of the fine mediator whose DE a DEM condition drives, where every continuum dof its
+// interpolation reaches is held too, constrains nothing that moves: both sides of u_p = u_c(X_p)
+// are prescribed (a clamped yarn DE on the plate's clamped face), its row of A is zero and D is
+// singular there. It is untied in every component (no multiplier, as a free component of a
+// partial tie), which keeps the low-rank form of A (docs/theory.md#woodbury) available.
+void CoupledModel::untie_prescribed_rows() {
+  if (!ops_.settings.fine_l2()) return;
+  const int np = ops_.num_particles();
+  for (int p = 0; p < np; ++p) {
+    if (inv_mass_d_[p] != 0.0) continue;
+    // A point on a held face interpolates from that face's nodes; the others' shape functions
+    // there are round-off (1e-14 of the face's), which reaches nothing.
+    double largest = 0.0;
+    for (SparseMatrix::InnerIterator it(ops_.Gc, p); it; ++it) largest = std::max(largest, std::abs(it.value()));
+    bool moves = false;
+    for (SparseMatrix::InnerIterator it(ops_.Gc, p); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        moves = moves || (std::abs(it.value()) > 1e-10 * largest && inv_mass_c_[3 * static_cast<std::size_t>(it.col()) + c] != 0.0);
+    if (moves) continue;
+    if (ops_.tied.size() == 0) ops_.tied.setOnes(np, 3);
+    ops_.tied.row(p).setZero();
+    ++prescribed_rows_;
+  }
+}
+
 CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone,
                            CoupledOptions options)
     : dem_(dem), continuum_(continuum), zone_(zone), options_(std::move(options)) {
@@ -85,6 +110,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   inv_mass_c_.resize(3 * static_cast<size_t>(nn));
   for (int d = 0; d < 3 * nn; ++d) inv_mass_c_[d] = 1.0 / continuum_.dof_mass()[d];
   for (int d : options_.held_continuum_dofs) inv_mass_c_.at(d) = 0.0;
+  untie_prescribed_rows();
   solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_, options_.multiplier_petsc_options);
 
   // Initial velocities onto the constraint.
@@ -149,7 +175,9 @@ std::string CoupledModel::summary() const {
     s << "; consistent quadrature: " << quadrature_correction_.points << " overlap points weighted for "
       << quadrature_correction_.nodes << " free nodes (largest change " << quadrature_correction_.largest_change
       << ", smallest weight " << quadrature_correction_.smallest_weight << " of a point's volume)";
-  s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component\n"
+  s << "; " << ops_.num_particles() << " coupled DEs, " << ops_.rows() << " multipliers per component";
+  if (prescribed_rows_ > 0) s << " (" << prescribed_rows_ << " of them untied: driven DEs where the continuum is held)";
+  s << "\n"
     << "coupling matrix A: " << solver_->backend() << ", " << solver_->nonzeros() << " non-zeros stored, "
     << solver_->systems() << " system(s) set up once\n"
     << "critical time step: DEM " << time_steps_.dem << " s, continuum " << time_steps_.continuum << " s";

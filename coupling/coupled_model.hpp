@@ -203,6 +203,7 @@ class CoupledModel {
   Matrix3 continuum_coupling_force() const;
 
  private:
+  void untie_prescribed_rows();
   // The phases of step(), in order (see the contract above).
   void constraint_half_kick(double dt);
   void advance_models(double dt);
@@ -236,6 +237,7 @@ class CoupledModel {
   Matrix3 vd_, lambda_;
   TimeSteps time_steps_;
   bool continuum_stiffness_floored_ = false;
+  int prescribed_rows_ = 0;  // rows untied by untie_prescribed_rows
   continuum::ContinuumSolver::WeightCorrection quadrature_correction_;
   double coupling_work_ = 0.0;
   double time_ = 0.0;

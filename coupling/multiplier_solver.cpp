@@ -86,10 +86,14 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() con
   a->tied.resize(rows, 3);
   const Eigen::VectorXd g = ops.Gd.diagonal();
   for (int r = 0; r < rows; ++r) {
-    const double d = g[r] * g[r] * inv_d_(r, 0);  // a DE's inverse mass is the same in x, y and z
-    if (!(d > 0.0)) return nullptr;               // a driven DE: D is singular
-    a->inv_D[r] = 1.0 / d;
     for (int c = 0; c < 3; ++c) a->tied(r, c) = is_tied(r, c) ? 1.0 : 0.0;
+    const double d = g[r] * g[r] * inv_d_(r, 0);  // a DE's inverse mass is the same in x, y and z
+    if (a->tied.row(r).any()) {
+      if (!(d > 0.0)) return nullptr;  // a driven DE, tied: D is singular
+      a->inv_D[r] = 1.0 / d;
+    } else {
+      a->inv_D[r] = 1.0;  // no multiplier in any component: the pivot only keeps D invertible
+    }
   }
   // U's columns: the continuum nodes G_c reaches from a row tied in a component the node can move in.
   std::vector<int> column(static_cast<std::size_t>(ops.Gc.cols()), -1);

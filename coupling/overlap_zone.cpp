@@ -46,9 +46,10 @@ const char* weight_shape_name(WeightShape shape) {
 }
 
 OverlapZone::OverlapZone(Membership contains, RampCoordinate ramp, Polyhedral shape, Weighting weighting,
-                         std::string description)
+                         std::string description, std::vector<RampCoordinate> convex_pieces)
     : contains_(std::move(contains)),
       ramp_(std::move(ramp)),
+      convex_pieces_(convex_pieces.empty() ? std::vector<RampCoordinate>{ramp_} : std::move(convex_pieces)),
       shape_(std::move(shape)),
       weighting_(weighting),
       description_(std::move(description)) {
@@ -76,14 +77,19 @@ double OverlapZone::volume_inside(const Polyhedron& cell) const {
     for (const Plane& plane : planes) clip(poly, plane.n, plane.d, /*tag, not read here*/ -1, tol);
     return poly;
   };
-  const Polyhedron solid = clipped(cell, shape_.solid);
-  double v = volume(solid);
-  if (!shape_.hole.empty()) v -= volume(clipped(solid, shape_.hole));
+  double v = 0.0;
+  for (const Term& term : shape_.terms) v += term.sign * volume(clipped(cell, term.planes));
   return std::max(v, 0.0);
 }
 
 bool OverlapZone::in_dem_domain(const Vec3& x) const { return ramp_(x) <= 1.0 + kRampTolerance; }
 bool OverlapZone::in_pure_dem_zone(const Vec3& x) const { return ramp_(x) <= kRampTolerance; }
+
+bool OverlapZone::hull_in_pure_dem_zone(std::span<const Vec3> points) const {
+  return std::any_of(convex_pieces_.begin(), convex_pieces_.end(), [&points](const RampCoordinate& s) {
+    return std::all_of(points.begin(), points.end(), [&s](const Vec3& x) { return s(x) <= kRampTolerance; });
+  });
+}
 
 double OverlapZone::alpha_d(const Vec3& x) const {
   const double s = ramp_(x);
@@ -111,7 +117,7 @@ OverlapZone OverlapZone::box(const Box& b, int axis, bool dem_on_lower_side, Wei
   std::ostringstream d;
   d << "box " << vec(b.lower) << "-" << vec(b.upper) << ", ramp along axis " << axis << " with the DEM on the "
     << (dem_on_lower_side ? "lower" : "upper") << " side";
-  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), {box_planes(b), {}, b},
+  return OverlapZone([region](const Vec3& x) { return region.contains(x); }, std::move(ramp), {{{box_planes(b), 1.0}}, b},
                      weighting, d.str());
 }
 
@@ -126,14 +132,15 @@ OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting
   // The end planes, and the curved side as the circumscribed regular polygon: its faces touch
   // the circle at their middles, at distance `radius` from the axis.
   Polyhedral shape;
-  shape.solid.push_back({axis, dot(axis, base) + length});
-  shape.solid.push_back({-1.0 * axis, -dot(axis, base)});
+  std::vector<Plane>& solid = shape.terms.emplace_back().planes;
+  solid.push_back({axis, dot(axis, base) + length});
+  solid.push_back({-1.0 * axis, -dot(axis, base)});
   const Vec3 e1 = normalized(std::abs(axis.x) < 0.9 ? cross(axis, Vec3{1, 0, 0}) : cross(axis, Vec3{0, 1, 0}));
   const Vec3 e2 = cross(axis, e1);
   for (int k = 0; k < kCylinderSides; ++k) {
     const double phi = 2.0 * std::numbers::pi * k / kCylinderSides;
     const Vec3 n = std::cos(phi) * e1 + std::sin(phi) * e2;
-    shape.solid.push_back({n, dot(n, base) + c.radius});
+    solid.push_back({n, dot(n, base) + c.radius});
   }
   const Vec3 top = base + length * axis;
   for (int k = 0; k < 3; ++k)
@@ -146,7 +153,10 @@ OverlapZone OverlapZone::cylinder(const Cylinder& c, bool dem_at_base, Weighting
                      weighting, d.str());
 }
 
-OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting weighting) {
+namespace {
+
+// A shell's ramp (OverlapZone::shell); InputError unless the boxes nest and differ somewhere.
+OverlapZone::RampCoordinate shell_ramp(const Box& inner, const Box& outer) {
   bool ramps = false;
   for (int k = 0; k < 3; ++k) {
     if (!(outer.lower[k] <= inner.lower[k] && inner.lower[k] < inner.upper[k] && inner.upper[k] <= outer.upper[k]))
@@ -154,7 +164,7 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
     ramps = ramps || outer.lower[k] < inner.lower[k] || inner.upper[k] < outer.upper[k];
   }
   if (!ramps) throw SettingError("overlap", "the shell has the same inner and outer box");
-  RampCoordinate ramp = [=](const Vec3& x) {
+  return [=](const Vec3& x) {
     double s = -1e300;
     for (int k = 0; k < 3; ++k) {
       if (outer.lower[k] < inner.lower[k])
@@ -164,12 +174,74 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
     }
     return s;
   };
-  const Region out{outer};
-  Membership contains = [out, ramp](const Vec3& x) { return out.contains(x) && ramp(x) >= -kRampTolerance; };
+}
+
+std::string shell_description(const Box& inner, const Box& outer) {
   std::ostringstream d;
   d << "shell between box " << vec(inner.lower) << "-" << vec(inner.upper) << " (DEM inside) and box "
     << vec(outer.lower) << "-" << vec(outer.upper);
-  return OverlapZone(std::move(contains), std::move(ramp), {box_planes(outer), box_planes(inner), outer}, weighting, d.str());
+  return d.str();
+}
+
+}  // namespace
+
+OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting weighting) {
+  RampCoordinate ramp = shell_ramp(inner, outer);
+  const Region out{outer};
+  Membership contains = [out, ramp](const Vec3& x) { return out.contains(x) && ramp(x) >= -kRampTolerance; };
+  // The inner box's volume is taken inside the outer one's (its planes after the outer's).
+  std::vector<Plane> both = box_planes(outer);
+  for (const Plane& plane : box_planes(inner)) both.push_back(plane);
+  return OverlapZone(std::move(contains), std::move(ramp), {{{box_planes(outer), 1.0}, {std::move(both), -1.0}}, outer},
+                     weighting, shell_description(inner, outer));
+}
+
+OverlapZone OverlapZone::shells(const std::vector<std::pair<Box, Box>>& inner_outer, Weighting weighting) {
+  const int n = static_cast<int>(inner_outer.size());
+  if (n < 1 || n > kMaxShells)
+    throw SettingError("overlap", "a union of shells takes 1 to " + std::to_string(kMaxShells) + " shells, got " + std::to_string(n));
+  if (n == 1) return shell(inner_outer[0].first, inner_outer[0].second, weighting);
+  std::vector<RampCoordinate> ramps;
+  std::vector<Region> outers;
+  Polyhedral shape;
+  shape.bounds = inner_outer[0].second;
+  std::ostringstream description;
+  description << "union of " << n << " shells";
+  for (const auto& [inner, outer] : inner_outer) {
+    ramps.push_back(shell_ramp(inner, outer));
+    outers.push_back(Region{outer});
+    for (int k = 0; k < 3; ++k) {
+      shape.bounds.lower[k] = std::min(shape.bounds.lower[k], outer.lower[k]);
+      shape.bounds.upper[k] = std::max(shape.bounds.upper[k], outer.upper[k]);
+    }
+    description << (ramps.size() == 1 ? ": " : "; ") << shell_description(inner, outer);
+  }
+  // |cell in the union of the outer boxes| - |cell in the union of the inner boxes| (each inner
+  // box inside its outer one), each union by inclusion and exclusion: the boxes of a subset S
+  // intersected, with the sign (-1)^(|S| + 1).
+  for (unsigned subset = 1; subset < (1u << n); ++subset) {
+    Term outer_term, inner_term;
+    int members = 0;
+    for (int k = 0; k < n; ++k)
+      if (subset >> k & 1u) {
+        ++members;
+        for (const Plane& plane : box_planes(inner_outer[static_cast<std::size_t>(k)].second)) outer_term.planes.push_back(plane);
+        for (const Plane& plane : box_planes(inner_outer[static_cast<std::size_t>(k)].first)) inner_term.planes.push_back(plane);
+      }
+    outer_term.sign = members % 2 == 1 ? 1.0 : -1.0;
+    inner_term.sign = -outer_term.sign;
+    shape.terms.push_back(std::move(outer_term));
+    shape.terms.push_back(std::move(inner_term));
+  }
+  RampCoordinate ramp = [ramps](const Vec3& x) {
+    double s = 1e300;
+    for (const RampCoordinate& r : ramps) s = std::min(s, r(x));
+    return s;
+  };
+  Membership contains = [outers, ramp](const Vec3& x) {
+    return std::any_of(outers.begin(), outers.end(), [&x](const Region& r) { return r.contains(x); }) && ramp(x) >= -kRampTolerance;
+  };
+  return OverlapZone(std::move(contains), std::move(ramp), std::move(shape), weighting, description.str(), std::move(ramps));
 }
 
 }  // namespace arlequin::coupling

@@ -19,15 +19,19 @@
 //    tetrahedron with all its vertices there has alpha_c = 0 throughout and is left out.
 //  - volume_inside(cell): the volume of a convex polyhedron's part in the overlap, a coupled DE's
 //    share of the overlap's integrals (its Laguerre cell clipped by the overlap,
-//    coupling_operators.hpp). The overlap is held as a convex polyhedron (a list of half-spaces)
-//    minus another (the shell's inner box); the cylinder's curved side is the circumscribed
+//    coupling_operators.hpp). The overlap is held as a signed sum of convex polyhedra (lists of
+//    half-spaces: a shell is its outer box minus its inner one); the cylinder's curved side is the circumscribed
 //    regular polygon of kCylinderSides sides (its area exceeds the circle's by 2.0e-4 of it; only
 //    cells the side cuts see the difference).
-//  - Shapes: a box slab (ramp along one axis), a finite cylinder (ramp along its axis), or the
-//    shell between two nested boxes (DEM inside the inner box, continuum outside the outer one).
+//  - Shapes: a box slab (ramp along one axis), a finite cylinder (ramp along its axis), the
+//    shell between two nested boxes (DEM inside the inner box, continuum outside the outer one),
+//    or a union of such shells (DEM inside any inner box: a cross of two bands, s the smallest
+//    of the shells' ramps, so alpha_d the largest of their weights; its volume by inclusion and
+//    exclusion over the boxes).
 //  - Bad input (empty slab, non-nested shell, unknown shape name) is an InputError.
 #pragma once
 #include <functional>
+#include <span>
 #include <string>
 
 #include <vector>
@@ -64,11 +68,20 @@ class OverlapZone {
   // s = max over axes and sides of the fractional distance from the inner face to the outer
   // face; a side where the two faces coincide does not ramp.
   static OverlapZone shell(const Box& inner, const Box& outer, Weighting weighting);
+  // The union of shells (inner, outer), at most kMaxShells: DEM inside any inner box, continuum
+  // outside every outer one; s = the smallest of the shells' s. One shell is shell().
+  static OverlapZone shells(const std::vector<std::pair<Box, Box>>& inner_outer, Weighting weighting);
 
   bool contains(const Vec3& x) const { return contains_(x); }
   double ramp(const Vec3& x) const { return ramp_(x); }
   bool in_dem_domain(const Vec3& x) const;
   bool in_pure_dem_zone(const Vec3& x) const;
+  // Whether the convex hull of `points` lies in the pure-DEM zone (a continuum tetrahedron that
+  // can be left out): all of them in one convex piece of it (a shell's inner side, a slab's or a
+  // cylinder's half-space). For a union of shells, vertices in the zone are not enough: a
+  // tetrahedron across the re-entrant corner where two bands meet has them all there and
+  // covers overlap.
+  bool hull_in_pure_dem_zone(std::span<const Vec3> points) const;
   double alpha_d(const Vec3& x) const;
   double alpha_c(const Vec3& x) const { return 1.0 - alpha_d(x); }
   double mass_floor() const { return weighting_.mass_floor; }
@@ -79,21 +92,30 @@ class OverlapZone {
   const Box& bounds() const { return shape_.bounds; }
 
   static constexpr int kCylinderSides = 128;
+  static constexpr int kMaxShells = 4;  // inclusion-exclusion takes 2 (2^n - 1) clipped volumes a cell
 
  private:
   struct Plane {  // the half-space n.x <= d, n unit
     Vec3 n;
     double d;
   };
-  // The overlap = intersection of `solid` minus the intersection of `hole` (empty: no hole).
-  struct Polyhedral {
-    std::vector<Plane> solid, hole;
-    Box bounds;  // contains solid
+  // The overlap = sum over the terms of sign x (the intersection of the term's half-spaces).
+  struct Term {
+    std::vector<Plane> planes;
+    double sign = 1.0;
   };
-  OverlapZone(Membership contains, RampCoordinate ramp, Polyhedral shape, Weighting weighting, std::string description);
+  struct Polyhedral {
+    std::vector<Term> terms;
+    Box bounds;  // contains the overlap
+  };
+  // convex_pieces: ramps whose s <= 0 regions are convex and make up the pure-DEM zone
+  // (empty: the ramp's own, a convex zone).
+  OverlapZone(Membership contains, RampCoordinate ramp, Polyhedral shape, Weighting weighting, std::string description,
+              std::vector<RampCoordinate> convex_pieces = {});
   static std::vector<Plane> box_planes(const Box& box);
   Membership contains_;
   RampCoordinate ramp_;
+  std::vector<RampCoordinate> convex_pieces_;
   Polyhedral shape_;
   Weighting weighting_;
   std::string description_;

@@ -53,7 +53,8 @@ TEST(ContinuumMesh, LeftOutRegionCutsTetrahedraNodesAndGroups) {
   for (int order : {1, 2}) {
     const Mesh full = Mesh::load({mesh_path("unit_cube.geo"), 0.25, order, {}});
     const auto cut = [](const Vec3& x) { return x.x <= 0.5 + 1e-12; };
-    const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.25, order, cut});
+    const auto tet_in_cut = [&cut](const std::array<Vec3, 4>& v) { return std::all_of(v.begin(), v.end(), cut); };
+    const Mesh m = Mesh::load({mesh_path("unit_cube.geo"), 0.25, order, tet_in_cut});
     int dropped = 0;
     double kept_volume = 0.0;
     for (int e = 0; e < full.num_tets(); ++e) {

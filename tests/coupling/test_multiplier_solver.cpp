@@ -259,3 +259,32 @@ TEST(CouplingMultiplierSolver, AFreeComponentKeepsItsVelocitiesAndTheHeldOnesMee
       EXPECT_EQ(vd_w(static_cast<Eigen::Index>(p), c), vd(static_cast<Eigen::Index>(p), c)) << p << c;
     }
 }
+
+// A row tied in no component whose DE is driven (inverse mass 0: a clamped DE on the
+// continuum's clamped face, CoupledModel's untied prescribed rows) has no multiplier and needs no
+// pivot of D: the Woodbury form still applies (it fell back to the general factor), gives the
+// factor's multipliers, and leaves that DE's velocity alone.
+TEST(CouplingMultiplierSolver, AnUntiedDrivenRowKeepsTheWoodburyForm) {
+  auto [fine, md, mc] = shared_nodes();
+  const int np = fine.num_particles(), nn = static_cast<int>(fine.Gc.cols()), driven = 4;
+  md[driven] = 0.0;
+  std::vector<std::array<bool, 3>> ties(static_cast<std::size_t>(np), {true, true, true});
+  ties[driven] = {false, false, false};
+  fine.tie_components(ties);
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;
+  const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
+  EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
+  Matrix3 vd(np, 3), vc(nn, 3), dd, dc, lambda_w, lambda_f, residual;
+  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
+  for (int i = 0; i < nn; ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
+  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc;
+  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
+  factor.project(vd_f, vc_f, dd, dc, lambda_f);
+  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
+  EXPECT_LT((vc_w - vc_f).norm(), 1e-10 * vc.norm());
+  EXPECT_EQ(lambda_w.row(driven), Eigen::RowVector3d::Zero().eval());
+  EXPECT_EQ(vd_w.row(driven), vd.row(driven));
+  woodbury.residual(vd_w, vc_w, residual);
+  EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());
+}

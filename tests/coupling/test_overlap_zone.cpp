@@ -2,6 +2,7 @@
 // Overlap zone and weight functions: alpha_d + alpha_c = 1, shapes across the ramp, membership.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -100,4 +101,52 @@ TEST(CouplingOverlapZone, BadInputIsAnInputError) {
   EXPECT_THROW(OverlapZone::shell({{0, 0, 0}, {2, 2, 2}}, {{1, 1, 1}, {3, 3, 3}}, {}), InputError);
   EXPECT_THROW(weight_shape_from_name("quadratic"), InputError);
   EXPECT_EQ(weight_shape_from_name("cubic"), WeightShape::cubic);
+}
+
+// A cross of two bands in the plane z in [0, 1] (a woven target's DEM along its principal yarns):
+// band A along x (inner |y| <= 1, outer |y| <= 2), band B along y (inner |x| <= 1, outer
+// |x| <= 2), each 20 long. The DEM weight is the larger of the two bands' (s the smaller ramp),
+// and a cell's share of the overlap is its volume in the union of the outer boxes less that in
+// the union of the inner ones, against volumes worked out by hand.
+TEST(CouplingOverlapZone, UnionOfShellsIsACrossOfBands) {
+  const Box inner_a{{-10, -1, 0}, {10, 1, 1}}, outer_a{{-10, -2, 0}, {10, 2, 1}};
+  const Box inner_b{{-1, -10, 0}, {1, 10, 1}}, outer_b{{-2, -10, 0}, {2, 10, 1}};
+  const OverlapZone cross = OverlapZone::shells({{inner_a, outer_a}, {inner_b, outer_b}}, {});
+  EXPECT_DOUBLE_EQ(cross.alpha_d({5, 0, 0.5}), 1.0);   // inside band A's core
+  EXPECT_DOUBLE_EQ(cross.alpha_d({0, 5, 0.5}), 1.0);   // inside band B's core
+  EXPECT_DOUBLE_EQ(cross.alpha_d({5, 1.5, 0.5}), 0.5);  // half way across band A's overlap
+  EXPECT_DOUBLE_EQ(cross.alpha_d({1.5, 1.5, 0.5}), 0.5);  // in both overlaps: the larger weight
+  EXPECT_DOUBLE_EQ(cross.alpha_d({1.25, 1.75, 0.5}), 0.75);
+  EXPECT_DOUBLE_EQ(cross.alpha_d({0.5, 1.75, 0.5}), 1.0);  // band B's core, band A's overlap
+  EXPECT_DOUBLE_EQ(cross.alpha_d({5, 5, 0.5}), 0.0);    // between the arms: continuum
+  EXPECT_TRUE(cross.contains({5, 1.5, 0.5}));
+  EXPECT_TRUE(cross.contains({1.5, 1.5, 0.5}));
+  EXPECT_FALSE(cross.contains({0.5, 1.75, 0.5}));
+  EXPECT_FALSE(cross.contains({5, 5, 0.5}));
+  EXPECT_TRUE(cross.in_pure_dem_zone({0, 5, 0.5}));
+  EXPECT_FALSE(cross.in_dem_domain({5, 5, 0.5}));
+  auto cell = [](double x0, double y0, double x1, double y1) { return box_polyhedron({x0, y0, 0}, {x1, y1, 1}, 0); };
+  // The corner square between the arms' overlaps, [1, 2]^2: all overlap.
+  EXPECT_NEAR(cross.volume_inside(cell(1, 1, 2, 2)), 1.0, 1e-14);
+  // [0, 3]^2: the L of the outer arms there, 2 x 3 + 3 x 2 - 2 x 2 = 8, less the inner L,
+  // 1 x 3 + 3 x 1 - 1 x 1 = 5.
+  EXPECT_NEAR(cross.volume_inside(cell(0, 0, 3, 3)), 3.0, 1e-14);
+  // Across band A only, far from B: the two 1-wide strips of its overlap.
+  EXPECT_NEAR(cross.volume_inside(cell(5, -3, 6, 3)), 2.0, 1e-14);
+  EXPECT_EQ(cross.volume_inside(cell(4, 4, 6, 6)), 0.0);
+  // A tetrahedron across the re-entrant corner at (1, 1): each vertex in a band's core, the edge
+  // between the first two through (1.4, 1.4), in both overlaps. It is not left out of the mesh;
+  // one in band A's core is.
+  const std::array<Vec3, 4> across{Vec3{1.9, 0.9, 0}, Vec3{0.9, 1.9, 0}, Vec3{1.9, 0.9, 1}, Vec3{0.5, 0.5, 1}};
+  for (const Vec3& v : across) EXPECT_TRUE(cross.in_pure_dem_zone(v));
+  EXPECT_FALSE(cross.hull_in_pure_dem_zone(across));
+  EXPECT_TRUE(cross.hull_in_pure_dem_zone(std::array<Vec3, 4>{Vec3{5, 0, 0}, Vec3{6, 0.9, 0}, Vec3{5, -0.9, 1}, Vec3{0.5, 0.5, 1}}));
+  // One shell is the shell, to the bit.
+  const OverlapZone one = OverlapZone::shells({{inner_a, outer_a}}, {}), shell = OverlapZone::shell(inner_a, outer_a, {});
+  EXPECT_EQ(one.description(), shell.description());
+  EXPECT_EQ(one.volume_inside(cell(1, 1, 2, 2)), shell.volume_inside(cell(1, 1, 2, 2)));
+  // Bad input: none, too many, one not nested.
+  EXPECT_THROW(OverlapZone::shells({}, {}), InputError);
+  EXPECT_THROW(OverlapZone::shells(std::vector<std::pair<Box, Box>>(OverlapZone::kMaxShells + 1, {inner_a, outer_a}), {}), InputError);
+  EXPECT_THROW(OverlapZone::shells({{inner_a, outer_a}, {outer_b, inner_b}}, {}), InputError);
 }

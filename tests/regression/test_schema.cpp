@@ -98,6 +98,9 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
             dir_);
   read_case(coupled, {"coupling.type=h1", "coupling.length=1.0e-3", "coupling.weight=constant", "coupling.solver=direct"}, dir_);
   read_case(coupled, {"coupling.overlap={shell: {inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}}"}, dir_);
+  read_case(coupled, {"coupling.overlap={shells: [{inner: [[0, 0, 0], [1, 1, 1]], outer: [[-1, -1, -1], [2, 2, 2]]}, "
+                      "{inner: [[0, 0, 0], [3, 0.5, 1]], outer: [[-1, -1, -1], [4, 1, 2]]}]}"},
+            dir_);
   read_case(cases + "dcb_coupled/case.yaml",  // its band overlap, on the DCB's packing above
             {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
              "continuum.mesh.file=../../meshes/dcb_arms_coarse.geo", "coupling.overlap.band.half_thickness=1.0e-3",
