@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <string>
 
 #include "common/convex_polyhedron.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "dem/neighbour_list.hpp"
 
 namespace arlequin::dem {
@@ -48,45 +50,60 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
     if (r[i] <= large)
       bins[(static_cast<std::size_t>(cell_of(c[i], 2)) * dims[1] + cell_of(c[i], 1)) * dims[0] + cell_of(c[i], 0)].push_back(i);
 
-  std::vector<std::pair<double, std::size_t>> near;
-  for (std::size_t k = 0; k < cells.size(); ++k) {
-    const std::size_t i = cells[k];
-    for (int reach = 2;; reach *= 2) {
-      // Every sphere within `reach` cells and every large one, nearest first (so later planes
-      // rarely cut).
-      near.clear();
-      const int ci[3] = {cell_of(c[i], 0), cell_of(c[i], 1), cell_of(c[i], 2)};
-      for (int z = std::max(0, ci[2] - reach); z <= std::min(dims[2] - 1, ci[2] + reach); ++z)
-        for (int y = std::max(0, ci[1] - reach); y <= std::min(dims[1] - 1, ci[1] + reach); ++y)
-          for (int x = std::max(0, ci[0] - reach); x <= std::min(dims[0] - 1, ci[0] + reach); ++x)
-            for (std::size_t j : bins[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x])
-              if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
-      for (std::size_t j : large_ones)
-        if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
-      std::sort(near.begin(), near.end());
-      Polyhedron poly = box_polyhedron(lo, hi, -1);
-      for (const auto& [d2, j] : near) {
-        if (!(d2 > 0.0)) throw InputError("laguerre cells: spheres " + std::to_string(i) + " and " + std::to_string(j) + " share a centre");
-        const Vec3 e = c[j] - c[i];
-        const double d = std::sqrt(d2);
-        // The radical plane, as (e/d).x <= offset.
-        const double offset = (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d);
-        clip(poly, e / d, offset, static_cast<int>(j), tol);
+  // The cells on the threads: each is built on its own, in the same order of planes on any
+  // thread count (the same bits), and a cell at a gap of the packing, whose search reaches far,
+  // costs a thousand times one deep inside it, so the threads take them a few at a time. An
+  // exception must not leave the parallel region: the failure of the lowest k is kept and thrown
+  // after it, as a serial loop would have thrown it.
+  const long count = static_cast<long>(cells.size());
+  long failed_at = count;
+  std::exception_ptr failure;
+  run_threaded_if(count > 64, [&] {
+    std::vector<std::pair<double, std::size_t>> near;
+#pragma omp for schedule(dynamic, 4)
+    for (long k = 0; k < count; ++k) try {
+      const std::size_t i = cells[static_cast<std::size_t>(k)];
+      for (int reach = 2;; reach *= 2) {
+        // Every sphere within `reach` cells and every large one, nearest first (so later planes
+        // rarely cut).
+        near.clear();
+        const int ci[3] = {cell_of(c[i], 0), cell_of(c[i], 1), cell_of(c[i], 2)};
+        for (int z = std::max(0, ci[2] - reach); z <= std::min(dims[2] - 1, ci[2] + reach); ++z)
+          for (int y = std::max(0, ci[1] - reach); y <= std::min(dims[1] - 1, ci[1] + reach); ++y)
+            for (int x = std::max(0, ci[0] - reach); x <= std::min(dims[0] - 1, ci[0] + reach); ++x)
+              for (std::size_t j : bins[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x])
+                if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+        for (std::size_t j : large_ones)
+          if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+        std::sort(near.begin(), near.end());
+        Polyhedron poly = box_polyhedron(lo, hi, -1);
+        for (const auto& [d2, j] : near) {
+          if (!(d2 > 0.0)) throw InputError("laguerre cells: spheres " + std::to_string(i) + " and " + std::to_string(j) + " share a centre");
+          const Vec3 e = c[j] - c[i];
+          const double d = std::sqrt(d2);
+          // The radical plane, as (e/d).x <= offset.
+          const double offset = (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d);
+          clip(poly, e / d, offset, static_cast<int>(j), tol);
+        }
+        // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
+        // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
+        // outside the searched cells is a binned one at least `reach` cells away.
+        double extent = 0.0;
+        for (const PolyFace& f : poly)
+          for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - c[i]));
+        const double D = reach * cell;
+        const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
+        if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {
+          on_cell(static_cast<std::size_t>(k), poly);
+          break;
+        }
       }
-      // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
-      // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
-      // outside the searched cells is a binned one at least `reach` cells away.
-      double extent = 0.0;
-      for (const PolyFace& f : poly)
-        for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - c[i]));
-      const double D = reach * cell;
-      const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
-      if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {
-        on_cell(k, poly);
-        break;
-      }
+    } catch (...) {
+#pragma omp critical(laguerre_failure)
+      if (k < failed_at) failed_at = k, failure = std::current_exception();
     }
-  }
+  });
+  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace

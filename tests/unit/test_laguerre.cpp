@@ -5,8 +5,10 @@
 #include <random>
 
 #include "common/convex_polyhedron.hpp"
+#include "common/error.hpp"
 #include "common/region.hpp"
 #include "dem/laguerre_cells.hpp"
+#include "support/omp_threads.hpp"
 
 using namespace arlequin;
 
@@ -193,4 +195,29 @@ TEST(LaguerreCells, CellsCutToABoxMeasureWhatTheWholeCellsDoInside) {
     sum += cut[k];
   }
   EXPECT_LT(sum, 0.5 * 0.3 * 0.25);  // the cells of the spheres inside cover part of the box
+}
+
+// The cells are built on the threads: the same bits on one and on two threads, and a failure (two
+// spheres with one centre, here among 400 so that the threads take the cells) is the one a
+// serial loop meets first, the lowest such cell.
+TEST(LaguerreCells, CellsOnTheThreadsAreTheSerialOnesAndFailTheSameWay) {
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  random_spheres(5, 400, c, r);
+#ifdef _OPENMP
+  std::vector<double> v[2];
+  for (int threads : {1, 2}) {
+    const test::OmpThreads scope(threads);
+    v[threads - 1] = dem::laguerre_volumes(c, r);
+  }
+  EXPECT_EQ(v[0], v[1]);
+#endif
+  c[300] = c[200];
+  c[350] = c[120];
+  try {
+    dem::laguerre_volumes(c, r);
+    ADD_FAILURE() << "spheres with one centre were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("spheres 120 and 350 share a centre"), std::string::npos) << e.what();
+  }
 }
