@@ -361,6 +361,7 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   report["other"] = describe_run(b);
   report["speedup_compute"] = speedup;
   report["sensors"] = sensors;
+  if (pairs == 1 && !first_breaks.empty()) report["first_break_relative_difference"] = first_breaks.front();
   if (pairs > 1) {
     Json e = Json::object();
     e["pairs"] = pairs;

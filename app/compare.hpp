@@ -8,8 +8,9 @@
 //   peak relative = (max |b| - max |a|) / max |a| (b at its own samples: a peak between a's is kept).
 // Also each run's energies at its end (DEM kinetic + bond + contact, continuum kinetic + strain,
 // fracture) and first break (summary.json), and the second's first break relative to the first's.
-// Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors) and one PNG
-// per sensor overlaying both time histories, into the output folder (atomically).
+// Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors, the first
+// break's relative difference where both runs broke) and one PNG per sensor overlaying both time
+// histories, into the output folder (atomically).
 //
 // An ensemble (`--ensemble N`, docs/decisions.md#d44) runs N pairs: pair k with both cases' time
 // steps scaled by 1 - k 1e-9, a perturbation far below either model's discretisation error that
@@ -38,7 +39,8 @@ inline constexpr double ensemble_time_step_perturbation = 1e-9;
 // Pair 0 writes to out_dir/reference and out_dir/other, pair k to out_dir/pair_k/... InputError,
 // before any run, when a case is bad, the cases share no sensor column, or an ensemble is asked
 // of two static solves. With an ensemble, compare.json's "reference" and "other" and the runs'
-// printed sizes and energies are pair 0's; every difference and the speed-up are medians.
+// printed sizes and energies are pair 0's; every difference and the speed-up are medians (the
+// first break's under "ensemble", with each pair's).
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                            const SceneOptions& reference, const SceneOptions& other, const std::filesystem::path& out_dir,
                            int ensemble = 1);

@@ -1055,6 +1055,23 @@ TEST(Cli, CompareBoundsTheCoupledErrorAndHonoursChecks) {
   EXPECT_FALSE(read_json_file(out / "failing" / "compare.json").at("other").at("checks_passed").get<bool>());
 }
 
+// A single comparison reports the first break's relative difference where both runs broke (the
+// figure compare prints): the lattice bar against itself with bonds of 90 instead of 200 MPa,
+// which break earlier under the same slow stretch.
+TEST(Cli, CompareReportsTheFirstBreaksRelativeDifference) {
+  const auto out = test::scratch_dir("compare_first_break");
+  const auto r = test::run_arlequin("compare " + cases + "lattice_bar_failure/case.yaml " + cases + "lattice_bar_failure/case.yaml"
+                                    " --set \"dem.sample.counts=[16,16,20]\" --set-other dem.bond.sigma_f=9.0e7"
+                                    " --set output.fields=[] --set checks=[] --out " + out.string(), "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json c = read_json_file(out / "compare.json");
+  const double t_reference = c.at("reference").at("first_break_time").get<double>();
+  const double t_other = c.at("other").at("first_break_time").get<double>();
+  EXPECT_LT(t_other, t_reference);
+  EXPECT_DOUBLE_EQ(c.at("first_break_relative_difference").get<double>(), (t_other - t_reference) / t_reference);
+  EXPECT_FALSE(c.contains("ensemble"));
+}
+
 // compare --ensemble: pairs of runs with both time steps moved by k 1e-9 (docs/decisions.md#d44).
 // The wave bar is linear, not chaotic: the perturbation moves its runs in proportion to it (the
 // reference's own spread 1.3e-9 and 2.5e-9 of the probe's largest value for pairs 1 and 2,

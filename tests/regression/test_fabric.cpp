@@ -325,6 +325,22 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
   EXPECT_GT(coarse_R, 0.2);
 }
 
+// The issue's bounds on a comparison of the coupled target with the pure DEM (compare.json, and
+// the first break's relative difference, a pair's or the ensemble's median): the sphere's velocity
+// history within 5 % (max relative), the peak impact force within 10 %, the first break within 10 %.
+void expect_within_the_issues_bounds(const Json& report, double first_break, const std::string& label) {
+  for (const auto& sensor : report.at("sensors")) {
+    const std::string name = sensor.at("sensor").get<std::string>();
+    if (name == "sphere_velocity") {
+      EXPECT_LT(sensor.at("max_relative_difference").get<double>(), 0.05) << label;
+    }
+    if (name == "impact_force") {
+      EXPECT_LT(std::abs(sensor.at("peak_relative_difference").get<double>()), 0.10) << label;
+    }
+  }
+  EXPECT_LT(std::abs(first_break), 0.10) << label;
+}
+
 // Validation: the coupled seed target against the pure-DEM run, both with breakage, with the
 // plate in P2 elements (the case's) and in natural neighbours (`--set-other
 // continuum.solver=nem`: the plate with the patch's hole as eight convex pieces). One comparison
@@ -350,16 +366,7 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
     ASSERT_EQ(r.exit_code, 0) << solver << ": " << r.output;
     const Json report = Json::parse(test::read_text(out / "compare.json"));
     ASSERT_EQ(report.at("ensemble").at("pairs").get<int>(), 7);
-    for (const auto& sensor : report.at("sensors")) {
-      const std::string name = sensor.at("sensor").get<std::string>();
-      if (name == "sphere_velocity") {
-        EXPECT_LT(sensor.at("max_relative_difference").get<double>(), 0.05) << solver;
-      }
-      if (name == "impact_force") {
-        EXPECT_LT(std::abs(sensor.at("peak_relative_difference").get<double>()), 0.10) << solver;
-      }
-    }
-    EXPECT_LT(std::abs(report.at("ensemble").at("first_break_relative_difference").get<double>()), 0.10) << solver;
+    expect_within_the_issues_bounds(report, report.at("ensemble").at("first_break_relative_difference").get<double>(), solver);
 
     const auto unbreakable = test::scratch_dir("fabric_coupled_seed_unbreakable_" + solver);
     const auto u = test::run_arlequin("run " + coupled_dir + "case.yaml --set dem.sample.yarn.failure_strain=0 --set output.fields=[] " +
@@ -387,18 +394,7 @@ TEST(ValidationFabric, LargerTargetMatchesThePureDem) {
   const Json report = Json::parse(test::read_text(out / "compare.json"));
   EXPECT_TRUE(report.at("reference").at("completed").get<bool>());
   EXPECT_TRUE(report.at("other").at("completed").get<bool>());
-  for (const auto& sensor : report.at("sensors")) {
-    const std::string name = sensor.at("sensor").get<std::string>();
-    if (name == "sphere_velocity") {
-      EXPECT_LT(sensor.at("max_relative_difference").get<double>(), 0.05);
-    }
-    if (name == "impact_force") {
-      EXPECT_LT(std::abs(sensor.at("peak_relative_difference").get<double>()), 0.10);
-    }
-  }
-  const double t_pure = report.at("reference").at("first_break_time").get<double>();
-  const double t_coupled = report.at("other").at("first_break_time").get<double>();
-  EXPECT_LT(std::abs(t_coupled / t_pure - 1.0), 0.10);
+  expect_within_the_issues_bounds(report, report.at("first_break_relative_difference").get<double>(), "large");
   EXPECT_LT(worst_balance(test::read_csv(out / "other" / "series.csv")), 0.01 * impact_energy());
 }
 
