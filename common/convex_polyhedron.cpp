@@ -28,11 +28,11 @@ Polyhedron box_polyhedron(const Vec3& a, const Vec3& b, int tag) {
           {{V(0, 0, 1), V(0, 1, 1), V(1, 1, 1), V(1, 0, 1)}, {0, 0, 1}, tag}};
 }
 
-void clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol) {
+bool clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol) {
   bool cuts = false;
   for (const PolyFace& f : poly)
     for (const Vec3& p : f.pts) cuts = cuts || dot(n, p) - d > tol;
-  if (!cuts) return;
+  if (!cuts) return false;
   Polyhedron out;
   std::vector<Vec3> cap;
   for (const PolyFace& f : poly) {
@@ -65,6 +65,7 @@ void clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol) {
     if (cap.size() >= 3) out.push_back({std::move(cap), n, tag});
   }
   poly = std::move(out);
+  return true;
 }
 
 Vec3 vertex_centre(const PolyFace& f) {

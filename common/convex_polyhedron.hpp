@@ -23,8 +23,9 @@ Polyhedron box_polyhedron(const Vec3& lo, const Vec3& hi, int tag);
 // Keeps the part of `poly` with n.x <= d (Sutherland-Hodgman per face, plus the cap polygon,
 // tagged `tag`). Vertices within `tol` (length) of the plane count as on it; a plane that cuts
 // no vertex by more than tol leaves poly unchanged. Polygon vertices within tol of their
-// predecessor are dropped (a vertex cut from two faces is computed twice).
-void clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol);
+// predecessor are dropped (a vertex cut from two faces is computed twice). Returns whether the
+// plane cut poly.
+bool clip(Polyhedron& poly, const Vec3& n, double d, int tag, double tol);
 
 // Centre of a face's vertices (not its area centroid).
 Vec3 vertex_centre(const PolyFace& f);

@@ -26,6 +26,9 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
   for (std::size_t i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
   const double tol = 1e-12 * norm(hi - lo);
+  // A bound on the relative round-off of a plane's test of a vertex (a dot product and the
+  // offset, a few ulps): the tests that pass over planes leave this much to clip's own.
+  constexpr double round_off = 1e-14;
   if (within)
     for (int k = 0; k < 3; ++k) lo[k] = std::max(lo[k], within->lower[k]), hi[k] = std::min(hi[k], within->upper[k]);
   // Spheres far larger than the median (an impactor among yarn DEs) are a neighbour of every
@@ -60,12 +63,14 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
   std::exception_ptr failure;
   run_threaded_if(count > 64, [&] {
     std::vector<std::pair<double, std::size_t>> near;
+    std::vector<std::size_t> large_left;
 #pragma omp for schedule(dynamic, 4)
     for (long k = 0; k < count; ++k) try {
       const std::size_t i = cells[static_cast<std::size_t>(k)];
+      // The distance from c_i of sphere j's radical plane (R_i^2 - R_j^2 moves it from d / 2).
+      const auto plane_distance = [&](double d2, std::size_t j) { return (d2 + r[i] * r[i] - r[j] * r[j]) / (2.0 * std::sqrt(d2)); };
       for (int reach = 2;; reach *= 2) {
-        // Every sphere within `reach` cells and every large one, nearest first (so later planes
-        // rarely cut).
+        // Every sphere within `reach` cells and every large one.
         near.clear();
         const int ci[3] = {cell_of(c[i], 0), cell_of(c[i], 1), cell_of(c[i], 2)};
         for (int z = std::max(0, ci[2] - reach); z <= std::min(dims[2] - 1, ci[2] + reach); ++z)
@@ -73,24 +78,58 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
             for (int x = std::max(0, ci[0] - reach); x <= std::min(dims[0] - 1, ci[0] + reach); ++x)
               for (std::size_t j : bins[(static_cast<std::size_t>(z) * dims[1] + y) * dims[0] + x])
                 if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+        large_left.clear();
         for (std::size_t j : large_ones)
-          if (j != i) near.emplace_back(norm2(c[j] - c[i]), j);
+          if (j != i) near.emplace_back(norm2(c[j] - c[i]), j), large_left.push_back(j);
+        // Their planes cut the box nearest first (so later planes rarely cut), until no plane left
+        // can cut the cell: a binned sphere at distance D >= that of the nearest left has its plane
+        // at least (D^2 - r_max^2) / 2D from c_i, a large one is looked at on its own. A plane
+        // that cuts nothing leaves the cell as it is (clip), and one clear of the cell's bounding
+        // box cuts nothing: such planes are passed over without looking at the cell's vertices.
+        // The cell is then the one every plane of the search in turn would give, to the bit.
         std::sort(near.begin(), near.end());
         Polyhedron poly = box_polyhedron(lo, hi, -1);
+        double extent = 0.0;
+        Vec3 bounds_lo, bounds_hi;
+        const auto measure_cell = [&] {  // of a cell not empty
+          extent = 0.0;
+          bounds_lo = bounds_hi = poly.front().pts.front();
+          for (const PolyFace& f : poly)
+            for (const Vec3& p : f.pts) {
+              extent = std::max(extent, norm(p - c[i]));
+              for (int a = 0; a < 3; ++a) bounds_lo[a] = std::min(bounds_lo[a], p[a]), bounds_hi[a] = std::max(bounds_hi[a], p[a]);
+            }
+        };
+        measure_cell();
         for (const auto& [d2, j] : near) {
+          const double margin = extent + tol + round_off * (norm(c[i]) + extent);
+          if (d2 > 0.0 && (d2 - r_max * r_max) / (2.0 * std::sqrt(d2)) > margin &&
+              std::all_of(large_left.begin(), large_left.end(),
+                          [&](std::size_t l) { return plane_distance(norm2(c[l] - c[i]), l) > margin; }))
+            break;
+          if (r[j] > large) large_left.erase(std::find(large_left.begin(), large_left.end(), j));
           if (!(d2 > 0.0)) throw InputError("laguerre cells: spheres " + std::to_string(i) + " and " + std::to_string(j) + " share a centre");
           const Vec3 e = c[j] - c[i];
           const double d = std::sqrt(d2);
           // The radical plane, as (e/d).x <= offset.
+          const Vec3 normal = e / d;
           const double offset = (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d);
-          clip(poly, e / d, offset, static_cast<int>(j), tol);
+          // Clear of the bounding box's corner farthest along the normal by more than clip's
+          // tolerance less a bound on the round-off of the two dot products.
+          Vec3 farthest;
+          for (int a = 0; a < 3; ++a) farthest[a] = normal[a] > 0.0 ? bounds_hi[a] : bounds_lo[a];
+          const double reach_of_box = dot(normal, farthest);
+          if (reach_of_box - offset + round_off * (std::abs(reach_of_box) + std::abs(offset)) <= tol) continue;
+          if (!clip(poly, normal, offset, static_cast<int>(j), tol)) continue;
+          if (poly.empty()) {  // a small sphere's cell inside its neighbours' power (no plane cuts it further)
+            extent = 0.0;
+            break;
+          }
+          measure_cell();
         }
         // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
         // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
         // outside the searched cells is a binned one at least `reach` cells away.
-        double extent = 0.0;
-        for (const PolyFace& f : poly)
-          for (const Vec3& p : f.pts) extent = std::max(extent, norm(p - c[i]));
         const double D = reach * cell;
         const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
         if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {

@@ -2,6 +2,8 @@
 // Laguerre cells (dem/laguerre_cells.hpp), the RDEF volume shares, against closed forms.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "common/convex_polyhedron.hpp"
@@ -163,6 +165,49 @@ TEST(LaguerreCells, ALargeSphereAmongSmallOnesGivesTheBruteForceCells) {
     sum += v[i];
   }
   EXPECT_NEAR(sum, (hi.x - lo.x) * (hi.y - lo.y) * (hi.z - lo.z), 1e-10 * sum);
+}
+
+// The search passes over the planes that cannot cut a cell (those clear of its bounding box, and
+// all of them once the nearest left is beyond twice its extent): every cell is the one the box
+// clipped by every other sphere's radical plane, nearest first, gives, to the bit. Two slabs of
+// spheres with a gap between them, so the cells facing the gap reach across it and their search
+// far out (the cells of a coupling's overlap facing the continuum, among thousands of planes);
+// an impactor above them (a large sphere, looked at on its own), and small spheres among large
+// ones, whose cells the neighbours' power can leave empty.
+TEST(LaguerreCells, PassingOverPlanesThatCannotCutGivesEveryPlanesCellToTheBit) {
+  std::vector<Vec3> c;
+  std::vector<double> r;
+  random_spheres(11, 400, c, r);
+  for (Vec3& x : c) x.z = x.z < 0.5 ? 0.3 * x.z : 0.7 + 0.3 * x.z;  // slabs z in [0, 0.15], [0.85, 1]
+  c.push_back({0.5, 0.5, 1.5});  // the impactor, radius 0.4
+  r.push_back(0.4);
+  Vec3 lo = c[0], hi = c[0];
+  for (std::size_t i = 0; i < c.size(); ++i)
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], c[i][k] - r[i]), hi[k] = std::max(hi[k], c[i][k] + r[i]);
+  const double tol = 1e-12 * norm(hi - lo);
+  const auto v = dem::laguerre_volumes(c, r);
+  int empty = 0, reaching = 0;
+  std::vector<std::pair<double, std::size_t>> nearest_first;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    nearest_first.clear();
+    for (std::size_t j = 0; j < c.size(); ++j)
+      if (j != i) nearest_first.emplace_back(norm2(c[j] - c[i]), j);
+    std::sort(nearest_first.begin(), nearest_first.end());
+    Polyhedron cell = box_polyhedron(lo, hi, -1);
+    for (const auto& [d2, j] : nearest_first) {
+      const Vec3 e = c[j] - c[i];
+      const double d = std::sqrt(d2);
+      clip(cell, e / d, (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d), int(j), tol);
+    }
+    EXPECT_EQ(v[i], volume(cell)) << "sphere " << i;
+    empty += cell.empty();
+    double extent = 0.0;
+    for (const PolyFace& f : cell)
+      for (const Vec3& p : f.pts) extent = std::max(extent, std::abs(p.z - c[i].z));
+    reaching += extent > 0.3;
+  }
+  EXPECT_GT(empty, 0);      // small spheres with no cell
+  EXPECT_GT(reaching, 50);  // cells across the gap
 }
 
 // Cells cut to a box `within` first (the coupling's overlap bounds) measure inside it what the
