@@ -411,6 +411,7 @@ class Coupled final : public SceneModel {
     return {dem_.energies(), model_->continuum_kinetic_energy(), continuum_.strain_energy(), model_->coupling_work(),
             continuum_.dissipated()};
   }
+  bool coupled() const override { return true; }
   std::optional<CouplingMonitorValues> monitor() const override {
     const coupling::CouplingMonitor m = model_->monitor();
     return CouplingMonitorValues{m.constraint_residual, m.velocity_mismatch, m.max_velocity_mismatch};

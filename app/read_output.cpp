@@ -362,7 +362,7 @@ std::vector<std::string> series_columns(const Scene& scene) {
   for (auto& c : sensor_columns(scene)) columns.push_back(c);
   columns.insert(columns.end(), std::begin(energy_columns), std::end(energy_columns));
   if (scene.continuum) columns.insert(columns.end(), {"C_kinetic", "C_strain"});
-  if (scene.model->monitor()) columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
+  if (scene.model->coupled()) columns.insert(columns.end(), std::begin(coupling_columns), std::end(coupling_columns));
   if (scene.dem.failure_enabled())
     for (const auto& set : scene.dem.bond_sets()) columns.push_back("broken_" + set->name);
   return columns;

@@ -41,7 +41,7 @@ double continuum_work(const Scene& scene) {
   return scene.continuum && !scene.static_only() ? scene.continuum->external_work() : 0.0;
 }
 std::pair<double, double> continuum_balance_terms(const Scene& scene) {
-  if (!scene.continuum || scene.static_only() || scene.model->monitor()) return {continuum_work(scene), 0.0};
+  if (!scene.continuum || scene.static_only() || scene.model->coupled()) return {continuum_work(scene), 0.0};
   return {continuum_work(scene), scene.continuum->verlet_correction(scene.dt)};
 }
 // A row's energy balance (docs/theory.md#energy): with a continuum it covers both models and the

@@ -52,6 +52,7 @@ class SceneModel {
   virtual double critical_time_step() const = 0;  // s; of the coupled system when coupled
   virtual SceneEnergies energies() const = 0;
   virtual std::optional<CouplingMonitorValues> monitor() const = 0;  // nullopt: nothing coupled
+  virtual bool coupled() const { return false; }  // whether monitor() has values, without computing them
   virtual std::optional<OverlapDamageReport> damage_in_overlap() { return std::nullopt; }
   // The frame's fields: particles (and bonds, as the plan asks) and the continuum's.
   virtual void write_fields(FieldsWriter& fields, const OutputPlan& plan) const = 0;

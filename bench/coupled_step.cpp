@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   const std::string case_file = argc > 2 ? argv[2] : source + "/cases/wave_bar_coupled/case.yaml";
   const std::string reference_file = argc > 3 ? argv[3] : source + "/cases/wave_bar_dem/case.yaml";
   arlequin::app::Scene scene = arlequin::app::build_scene(case_file, {});
-  if (!scene.model->monitor()) {
+  if (!scene.model->coupled()) {
     std::fprintf(stderr, "%s: not a coupled case\n", case_file.c_str());
     return 2;
   }
