@@ -67,8 +67,10 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
 #pragma omp for schedule(dynamic, 4)
     for (long k = 0; k < count; ++k) try {
       const std::size_t i = cells[static_cast<std::size_t>(k)];
-      // The distance from c_i of sphere j's radical plane (R_i^2 - R_j^2 moves it from d / 2).
+      // The distance from c_i of sphere j's radical plane (R_i^2 - R_j^2 moves it from d / 2), and
+      // the least of it for a binned sphere at distance D (R_i^2 >= 0, R_j <= r_max).
       const auto plane_distance = [&](double d2, std::size_t j) { return (d2 + r[i] * r[i] - r[j] * r[j]) / (2.0 * std::sqrt(d2)); };
+      const auto binned_plane_distance = [r_max](double D) { return (D * D - r_max * r_max) / (2.0 * D); };
       for (int reach = 2;; reach *= 2) {
         // Every sphere within `reach` cells and every large one.
         near.clear();
@@ -83,7 +85,7 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
           if (j != i) near.emplace_back(norm2(c[j] - c[i]), j), large_left.push_back(j);
         // Their planes cut the box nearest first (so later planes rarely cut), until no plane left
         // can cut the cell: a binned sphere at distance D >= that of the nearest left has its plane
-        // at least (D^2 - r_max^2) / 2D from c_i, a large one is looked at on its own. A plane
+        // at least binned_plane_distance(D) from c_i, a large one is looked at on its own. A plane
         // that cuts nothing leaves the cell as it is (clip), and one clear of the cell's bounding
         // box cuts nothing: such planes are passed over without looking at the cell's vertices.
         // The cell is then the one every plane of the search in turn would give, to the bit.
@@ -103,7 +105,7 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
         measure_cell();
         for (const auto& [d2, j] : near) {
           const double margin = extent + tol + round_off * (norm(c[i]) + extent);
-          if (d2 > 0.0 && (d2 - r_max * r_max) / (2.0 * std::sqrt(d2)) > margin &&
+          if (d2 > 0.0 && binned_plane_distance(std::sqrt(d2)) > margin &&
               std::all_of(large_left.begin(), large_left.end(),
                           [&](std::size_t l) { return plane_distance(norm2(c[l] - c[i]), l) > margin; }))
             break;
@@ -127,12 +129,10 @@ void for_each_cell(const std::vector<Vec3>& c, const std::vector<double>& r, con
           }
           measure_cell();
         }
-        // Complete if no sphere beyond the search can cut the cell: a sphere at distance D
-        // has its plane at least (D^2 - r_max^2) / 2D from c_i (R_i^2 >= 0), and every sphere
-        // outside the searched cells is a binned one at least `reach` cells away.
-        const double D = reach * cell;
+        // Complete if no sphere beyond the search can cut the cell: every sphere outside the
+        // searched cells is a binned one at least `reach` cells away.
         const bool everything = reach >= std::max({dims[0], dims[1], dims[2]});
-        if (everything || (D * D - r_max * r_max) / (2.0 * D) > extent) {
+        if (everything || binned_plane_distance(reach * cell) > extent) {
           on_cell(static_cast<std::size_t>(k), poly);
           break;
         }

@@ -26,6 +26,14 @@ void random_spheres(unsigned seed, int count, std::vector<Vec3>& c, std::vector<
   }
 }
 
+// Cuts `cell` by the radical plane between spheres i and j (the part on i's side kept).
+void clip_by_radical_plane(Polyhedron& cell, const std::vector<Vec3>& c, const std::vector<double>& r, std::size_t i, std::size_t j,
+                           double tol) {
+  const Vec3 e = c[j] - c[i];
+  const double d = norm(e);
+  clip(cell, e / d, (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d), int(j), tol);
+}
+
 }  // namespace
 
 // Two touching spheres, R 1 and 0.5, centres 1.5 apart: the radical plane 2 (1.5) x = 1.5^2 -
@@ -155,12 +163,8 @@ TEST(LaguerreCells, ALargeSphereAmongSmallOnesGivesTheBruteForceCells) {
   for (std::size_t i = 0; i < c.size(); ++i) {
     // Brute force: the box clipped by the radical plane of every other sphere.
     Polyhedron cell = box_polyhedron(lo, hi, -1);
-    for (std::size_t j = 0; j < c.size(); ++j) {
-      if (j == i) continue;
-      const Vec3 e = c[j] - c[i];
-      const double d = norm(e);
-      clip(cell, e / d, (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d), int(j), 1e-12);
-    }
+    for (std::size_t j = 0; j < c.size(); ++j)
+      if (j != i) clip_by_radical_plane(cell, c, r, i, j, 1e-12);
     EXPECT_NEAR(v[i], volume(cell), 1e-12) << "sphere " << i;
     sum += v[i];
   }
@@ -194,11 +198,7 @@ TEST(LaguerreCells, PassingOverPlanesThatCannotCutGivesEveryPlanesCellToTheBit) 
       if (j != i) nearest_first.emplace_back(norm2(c[j] - c[i]), j);
     std::sort(nearest_first.begin(), nearest_first.end());
     Polyhedron cell = box_polyhedron(lo, hi, -1);
-    for (const auto& [d2, j] : nearest_first) {
-      const Vec3 e = c[j] - c[i];
-      const double d = std::sqrt(d2);
-      clip(cell, e / d, (norm2(c[j]) - norm2(c[i]) - r[j] * r[j] + r[i] * r[i]) / (2.0 * d), int(j), tol);
-    }
+    for (const auto& [d2, j] : nearest_first) clip_by_radical_plane(cell, c, r, i, j, tol);
     EXPECT_EQ(v[i], volume(cell)) << "sphere " << i;
     empty += cell.empty();
     double extent = 0.0;
