@@ -2,6 +2,7 @@
 #include "app/compare.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -135,22 +136,34 @@ Json describe_run(const Run& r) {
   return j;
 }
 
-// One sensor column of run b against the reference run a (the header's definitions).
+// Whether each row of r lies in the window.
+std::vector<bool> rows_inside(const Run& r, const CompareWindow& window) {
+  if (window.column.empty()) return std::vector<bool>(r.rows.size(), true);
+  std::vector<bool> inside;
+  for (double v : r.column(window.column)) inside.push_back(window.low <= v && v <= window.high);
+  return inside;
+}
+
+// One sensor column of run b against the reference run a over the window (the header's definitions).
 struct Difference {
   double max_rel = 0, rms_rel = 0, peak_rel = 0;
 };
 
-Difference difference(const Run& a, const Run& b, const std::string& name) {
+Difference difference(const Run& a, const Run& b, const std::string& name, const CompareWindow& window) {
   const auto va = a.column(name), vb = resample(b.column("time"), b.column(name), a.column("time"));
+  const auto in_a = rows_inside(a, window), in_b = rows_inside(b, window);
   double max_diff = 0, max_ref = 0, max_other = 0, sum_diff = 0, sum_ref = 0;
   for (std::size_t k = 0; k < va.size(); ++k) {
+    if (!in_a[k]) continue;
     const double d = vb[k] - va[k];
     max_diff = std::max(max_diff, std::abs(d));
     max_ref = std::max(max_ref, std::abs(va[k]));
     sum_diff += d * d;
     sum_ref += va[k] * va[k];
   }
-  for (double v : b.column(name)) max_other = std::max(max_other, std::abs(v));  // its own peak, not resampled
+  const auto own = b.column(name);  // its own peak, not resampled
+  for (std::size_t k = 0; k < own.size(); ++k)
+    if (in_b[k]) max_other = std::max(max_other, std::abs(own[k]));
   const double ref = std::max(max_ref, 1e-300);
   return {max_diff / ref, std::sqrt(sum_diff / std::max(sum_ref, 1e-300)), (max_other - max_ref) / ref};
 }
@@ -189,9 +202,27 @@ Json numbers(const std::vector<double>& v) {
 
 }  // namespace
 
+CompareWindow parse_compare_window(const std::string& text) {
+  const auto refuse = [&text]() {
+    return InputError("--window '" + text + "': expected COLUMN=LO:HI with numbers LO <= HI, e.g. Delta=0.5e-3:2.0e-3");
+  };
+  const std::size_t equals = text.find('='), colon = text.find(':', equals == std::string::npos ? 0 : equals);
+  if (equals == 0 || equals == std::string::npos || colon == std::string::npos) throw refuse();
+  const auto number = [&](std::size_t from, std::size_t to) {
+    double v = 0.0;
+    // from_chars takes the whole text or fails: no empty string, spaces or trailing characters.
+    const auto [end, error] = std::from_chars(text.data() + from, text.data() + to, v);
+    if (from == to || error != std::errc() || end != text.data() + to || !std::isfinite(v)) throw refuse();
+    return v;
+  };
+  CompareWindow w{text.substr(0, equals), number(equals + 1, colon), number(colon + 1, text.size())};
+  if (w.low > w.high) throw refuse();
+  return w;
+}
+
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                            const SceneOptions& reference, const SceneOptions& other, const std::filesystem::path& out_dir,
-                           int ensemble) {
+                           int ensemble, const CompareWindow& window) {
   std::error_code ec;
   if (std::filesystem::equivalent(reference_case, other_case, ec))
     std::fprintf(stderr, "arlequin compare: warning: both runs are %s; the differences are run-to-run noise\n",
@@ -213,6 +244,13 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
       shared.push_back(sensors_a[k]), shared_units.push_back(units_a[k]);
   if (shared.empty())
     throw InputError(other_case.string() + ": shares no sensor column with " + reference_case.string());
+  if (!window.column.empty() && window.column != "time" &&
+      std::find(shared.begin(), shared.end(), window.column) == shared.end()) {
+    std::string columns = "time";
+    for (const auto& c : shared) columns += ", " + c;
+    throw InputError("--window " + window.column + "=...: '" + window.column + "' is not a column of both runs; they share " +
+                     columns);
+  }
   if (ensemble > 1 && prepared_a.scene->static_only() && prepared_b.scene->static_only())
     throw InputError("--ensemble " + std::to_string(ensemble) + ": both cases are static solves, which have no time step to "
                      "perturb: every pair would be the same");
@@ -234,6 +272,15 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   const Run& a = reference_runs[0];
   const Run& b = other_runs[0];
   const std::size_t pairs = reference_runs.size();
+  if (!window.column.empty()) {
+    const auto inside = rows_inside(a, window);
+    const auto rows = std::count(inside.begin(), inside.end(), true);
+    if (rows == 0)
+      throw InputError("--window " + window.column + "=...: no row of " + a.name + "'s series.csv has " + window.column + " in [" +
+                       std::to_string(window.low) + ", " + std::to_string(window.high) + "]");
+    std::printf("over the rows of %s with %s in [%g, %g]: %ld of %zu\n", a.name.c_str(), window.column.c_str(), window.low,
+                window.high, long(rows), inside.size());
+  }
 
   Json sensors = Json::array();
   std::string csv = "sensor,max_relative_difference,rms_relative_difference,peak_relative_difference";
@@ -251,10 +298,10 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
     const std::string& name = shared[s];
     std::vector<double> max_rel, rms_rel, peak_rel, spread, peak_spread;  // spread: the reference's, max rel.
     for (std::size_t k = 0; k < pairs; ++k) {
-      const Difference d = difference(reference_runs[k], other_runs[k], name);
+      const Difference d = difference(reference_runs[k], other_runs[k], name, window);
       max_rel.push_back(d.max_rel), rms_rel.push_back(d.rms_rel), peak_rel.push_back(d.peak_rel);
       if (k > 0) {
-        const Difference own = difference(a, reference_runs[k], name);
+        const Difference own = difference(a, reference_runs[k], name, window);
         spread.push_back(own.max_rel), peak_spread.push_back(own.peak_rel);
       }
     }
@@ -360,6 +407,7 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   report["reference"] = describe_run(a);
   report["other"] = describe_run(b);
   report["speedup_compute"] = speedup;
+  if (!window.column.empty()) report["window"] = Json{{"column", window.column}, {"low", window.low}, {"high", window.high}};
   report["sensors"] = sensors;
   if (pairs == 1 && !first_breaks.empty()) report["first_break_relative_difference"] = first_breaks.front();
   if (pairs > 1) {

@@ -5,7 +5,9 @@
 //
 // Differences, with b interpolated linearly onto a's output times:
 //   max relative = max |b - a| / max |a|,  RMS relative = rms(b - a) / rms(a),
-//   peak relative = (max |b| - max |a|) / max |a| (b at its own samples: a peak between a's is kept).
+//   peak relative = (max |b| - max |a|) / max |a| (b at its own samples: a peak between a's is kept),
+// over every row, or over a window (`--window COLUMN=LO:HI`): a's rows, and b's own samples for its
+// peak, whose COLUMN lies in [LO, HI] (the DCB's Delta in [0.5, 2] mm, docs/decisions.md#d51).
 // Also each run's energies at its end (DEM kinetic + bond + contact, continuum kinetic + strain,
 // fracture) and first break (summary.json), and the second's first break relative to the first's.
 // Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors, the first
@@ -20,6 +22,7 @@
 // difference means anything.
 #pragma once
 #include <filesystem>
+#include <string>
 
 #include "app/scene.hpp"
 
@@ -31,6 +34,16 @@ struct CompareOutcome {
   bool checks_passed = true;
 };
 
+// The rows a comparison looks at: those whose `column` (a sensor column of both runs, or time)
+// lies in [low, high]; every row where `column` is empty.
+struct CompareWindow {
+  std::string column;
+  double low = 0.0, high = 0.0;
+};
+
+// "COLUMN=LO:HI" (LO <= HI, numbers); InputError naming the option and the text otherwise.
+CompareWindow parse_compare_window(const std::string& text);
+
 // The relative change of the time step between two pairs of an ensemble.
 inline constexpr double ensemble_time_step_perturbation = 1e-9;
 
@@ -38,11 +51,12 @@ inline constexpr double ensemble_time_step_perturbation = 1e-9;
 // ensemble > 1, the further pairs after them (each pair's scenes built just before it runs).
 // Pair 0 writes to out_dir/reference and out_dir/other, pair k to out_dir/pair_k/... InputError,
 // before any run, when a case is bad, the cases share no sensor column, or an ensemble is asked
-// of two static solves. With an ensemble, compare.json's "reference" and "other" and the runs'
+// of two static solves, or the window's column is not one of both runs (after the runs, when no row
+// of the reference lies in the window). With an ensemble, compare.json's "reference" and "other" and the runs'
 // printed sizes and energies are pair 0's; every difference and the speed-up are medians (the
 // first break's under "ensemble", with each pair's).
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
                            const SceneOptions& reference, const SceneOptions& other, const std::filesystem::path& out_dir,
-                           int ensemble = 1);
+                           int ensemble = 1, const CompareWindow& window = {});
 
 }  // namespace arlequin::app

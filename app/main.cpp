@@ -79,8 +79,8 @@ constexpr const char* usage_build_sample =
     "  cache file matches), stores it in the cache file and prints its report and radius histogram\n";
 
 constexpr const char* usage_compare =
-    "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--ensemble N] [--set k=v ...]\n"
-    "                        [--set-reference k=v ...] [--set-other k=v ...]\n"
+    "usage: arlequin compare REFERENCE.yaml OTHER.yaml [--out DIR] [--ensemble N] [--window COLUMN=LO:HI]\n"
+    "                        [--set k=v ...] [--set-reference k=v ...] [--set-other k=v ...]\n"
     "  builds both cases first (a bad case, or none of their sensors shared, stops it before any\n"
     "  run), runs them (results in DIR/reference and DIR/other, default results/compare), then for\n"
     "  every sensor column they share prints OTHER's max and RMS difference relative to REFERENCE,\n"
@@ -89,6 +89,9 @@ constexpr const char* usage_compare =
     "  --ensemble N: N pairs, pair k = 0..N-1 with both time steps x (1 - k 1e-9) (results of k >= 1 in\n"
     "  DIR/pair_k/): the median and range over the pairs, and the reference's own spread; for runs\n"
     "  whose outcome is a draw (contacts, breakage; docs/decisions.md#d44)\n"
+    "  --window COLUMN=LO:HI: the differences over REFERENCE's rows whose COLUMN (time or a shared\n"
+    "  sensor) lies in [LO, HI], OTHER's peak over its own such rows; e.g. the DCB's Delta=0.5e-3:2.0e-3\n"
+    "  (docs/decisions.md#d51); the plots keep the whole histories\n"
     "  --set applies to both cases, --set-reference and --set-other (after it) to one: e.g. the\n"
     "  coupled case with --set-other continuum.solver=nem against a pure DEM, which has no continuum\n";
 
@@ -134,6 +137,7 @@ struct Arguments {
   bool quiet = false;
   bool help = false;
   int ensemble = 1;                  // compare --ensemble
+  app::CompareWindow window;         // compare --window
   std::vector<Override> reference_overrides, other_overrides;  // compare --set-reference, --set-other
 };
 
@@ -183,6 +187,8 @@ Arguments parse(int argc, char** argv) {
       a.steps = whole_number("a number of steps", 0, std::numeric_limits<long>::max(), "a whole number >= 0");
     } else if ((arg == "--set-reference" || arg == "--set-other") && a.command == "compare") {
       (arg == "--set-other" ? a.other_overrides : a.reference_overrides).emplace_back(value("key.path=value"), arg);
+    } else if (arg == "--window" && a.command == "compare") {
+      a.window = app::parse_compare_window(value("COLUMN=LO:HI"));
     } else if (arg == "--ensemble" && a.command == "compare") {
       a.ensemble = int(whole_number("a number of pairs", 1, 1000, "a whole number of pairs from 1 to 1000"));
     } else if (arg == "--restart" && a.command == "run") {
@@ -366,7 +372,7 @@ int compare(const Arguments& a) {
   app::SceneOptions reference = base, other = base;
   reference.overrides.insert(reference.overrides.end(), a.reference_overrides.begin(), a.reference_overrides.end());
   other.overrides.insert(other.overrides.end(), a.other_overrides.begin(), a.other_overrides.end());
-  const app::CompareOutcome outcome = app::run_compare(a.case_file, a.second_case, reference, other, out, a.ensemble);
+  const app::CompareOutcome outcome = app::run_compare(a.case_file, a.second_case, reference, other, out, a.ensemble, a.window);
   std::printf("comparison: %s (compare.csv, compare.json, compare_<sensor>.png)\n",
               std::filesystem::absolute(out).string().c_str());
   if (!outcome.completed) return 3;

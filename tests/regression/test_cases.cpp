@@ -215,6 +215,60 @@ TEST(Cli, CompareSetsEachCaseApart) {
   EXPECT_FALSE(std::filesystem::exists(bad_out / "reference" / "series.csv"));
 }
 
+// compare --window COLUMN=LO:HI judges the reference's rows whose COLUMN lies in [LO, HI] only
+// (docs/decisions.md#d51): the chain against itself less damped, over the middle of its run, gives
+// the figures computed here from the two series over those rows, not those of the whole run. A
+// window on no column of both runs, or not of the form COLUMN=LO:HI, is refused before any run.
+TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
+  const auto out = test::scratch_dir("compare_window");
+  const std::string pair = "compare " + cases + "cantilever_chain/case.yaml " + cases + "cantilever_chain/case.yaml "
+                           "--set time.end=2e-3 --set output.every=5e-5 --set checks=[] --set output.fields=[] "
+                           "--set-other dem.damping=100 --out " + out.string();
+  const auto r = test::run_arlequin(pair + " --window time=5e-4:1.5e-3", "stdout");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto a = test::read_csv(out / "reference" / "series.csv"), b = test::read_csv(out / "other" / "series.csv");
+  // b's deflection at time t, linear between its rows (its damping changes its step and output times).
+  const auto b_at = [&b](double t) {
+    std::size_t k = 1;
+    while (k + 1 < b.size() && test::number(b[k], "time") < t) ++k;
+    const double t0 = test::number(b[k - 1], "time"), t1 = test::number(b[k], "time");
+    const double s = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
+    return (1 - s) * test::number(b[k - 1], "tip_deflection") + s * test::number(b[k], "tip_deflection");
+  };
+  double max_diff = 0, max_ref = 0, whole_diff = 0, whole_ref = 0;
+  int rows = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const double t = test::number(a[k], "time"), va = test::number(a[k], "tip_deflection");
+    const double d = std::abs(b_at(t) - va);
+    whole_diff = std::max(whole_diff, d), whole_ref = std::max(whole_ref, std::abs(va));
+    if (t < 5e-4 || t > 1.5e-3) continue;
+    ++rows;
+    max_diff = std::max(max_diff, d), max_ref = std::max(max_ref, std::abs(va));
+  }
+  ASSERT_GE(rows, 19);
+  EXPECT_NE(r.output.find("over the rows of cantilever_chain with time in [0.0005, 0.0015]: " + std::to_string(rows) + " of"),
+            std::string::npos) << r.output;
+  const Json c = read_json_file(out / "compare.json");
+  EXPECT_EQ(c.at("window").at("column").get<std::string>(), "time");
+  const double expected = max_diff / max_ref, whole = whole_diff / whole_ref;
+  ASSERT_GT(std::abs(expected / whole - 1), 0.05);  // the window changes the figure
+  ASSERT_EQ(c.at("sensors").at(0).at("sensor").get<std::string>(), "tip_deflection");
+  EXPECT_NEAR(c.at("sensors").at(0).at("max_relative_difference").get<double>(), expected, 1e-9 * expected);
+
+  for (const auto& [window, message] : std::vector<std::pair<std::string, std::string>>{
+           {"tip_deflection", "--window 'tip_deflection': expected COLUMN=LO:HI with numbers LO <= HI"},
+           {"time=2e-3:1e-3", "--window 'time=2e-3:1e-3': expected COLUMN=LO:HI"},
+           {"time=0:x", "--window 'time=0:x': expected COLUMN=LO:HI"},
+           {"Delta=0:1", "--window Delta=...: 'Delta' is not a column of both runs; they share time, tip_deflection, clamp_reaction"}}) {
+    const auto bad_out = test::scratch_dir("compare_window_bad");
+    const auto bad = test::run_arlequin("compare " + cases + "cantilever_chain/case.yaml " + cases +
+                                        "cantilever_chain/case.yaml --window " + window + " --out " + bad_out.string());
+    EXPECT_EQ(bad.exit_code, 2) << bad.output;
+    EXPECT_NE(bad.output.find(message), std::string::npos) << bad.output;
+    EXPECT_FALSE(std::filesystem::exists(bad_out / "reference" / "series.csv"));
+  }
+}
+
 // --out must name a folder that can be written: refused before the run, as bad input. `check`
 // writes nothing and does not judge it.
 TEST(BadInput, OutputFolderThatIsAFile) {
