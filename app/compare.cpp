@@ -289,6 +289,13 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
            "reference_spread_peak_min,reference_spread_peak_max";
   csv += "\n";
   std::vector<Plot> plots;
+  // The plots' abscissa: the window's column (the DCB's P against Delta), time without one.
+  const std::string abscissa = window.column.empty() ? "time" : window.column;
+  const std::string abscissa_unit =
+      abscissa == "time" ? "s" : shared_units[std::find(shared.begin(), shared.end(), abscissa) - shared.begin()];
+  const auto labelled = [](const std::string& column, const std::string& unit) {
+    return unit == "1" ? column : column + " [" + unit + "]";
+  };
   if (pairs > 1)
     std::printf("%zu pairs: the median over them (lowest to highest); the reference's own spread is its runs of pairs "
                 "1..%zu against its run of pair 0\n", pairs, pairs - 1);
@@ -339,19 +346,20 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
                 figure(peak_rel, true).c_str());
     if (pairs > 1) std::printf(" up to %.3g %%, %+.3g to %+.3g %% |", 100 * spread_largest, 100 * own_lo, 100 * own_hi);
     std::printf("\n");
+    if (name == abscissa) continue;  // itself against itself
     // Pair 0's two histories named in the legend, the further pairs' dashed in their run's colour.
     Plot& plot = plots.emplace_back();
     plot.file = "compare_" + name + ".png";
     plot.title = name + ": " + b.name + " against " + a.name + (pairs > 1 ? " (" + std::to_string(pairs) + " pairs)" : "");
-    plot.x_label = "time [s]";
-    plot.y_label = shared_units[s] == "1" ? name : name + " [" + shared_units[s] + "]";
+    plot.x_label = labelled(abscissa, abscissa_unit);
+    plot.y_label = labelled(name, shared_units[s]);
     for (std::size_t k = 0; k < pairs; ++k)
       for (const Run* r : {&reference_runs[k], &other_runs[k]}) {
         PlotCurve& curve = plot.curves.emplace_back();
         curve.label = k == 0 ? r->name : "";
         curve.style = k == 0 ? PlotCurve::Style::line : PlotCurve::Style::dashed;
         curve.colour = r == &reference_runs[k] ? 0 : 1;
-        curve.x = r->column("time"), curve.y = r->column(name);
+        curve.x = r->column(abscissa), curve.y = r->column(name);
       }
   }
 

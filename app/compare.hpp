@@ -7,7 +7,8 @@
 //   max relative = max |b - a| / max |a|,  RMS relative = rms(b - a) / rms(a),
 //   peak relative = (max |b| - max |a|) / max |a| (b at its own samples: a peak between a's is kept),
 // over every row, or over a window (`--window COLUMN=LO:HI`): a's rows, and b's own samples for its
-// peak, whose COLUMN lies in [LO, HI] (the DCB's Delta in [0.5, 2] mm, docs/decisions.md#d51).
+// peak, whose COLUMN lies in [LO, HI] (the DCB's Delta in [0.5, 2] mm, docs/decisions.md#d51); the
+// plots then draw each sensor's whole history against COLUMN (the DCB's P(Delta)).
 // Also each run's energies at its end (DEM kinetic + bond + contact, continuum kinetic + strain,
 // fracture) and first break (summary.json), and the second's first break relative to the first's.
 // Writes compare.csv (one row per sensor), compare.json (runs, speed-up, sensors, the first

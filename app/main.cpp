@@ -91,7 +91,7 @@ constexpr const char* usage_compare =
     "  whose outcome is a draw (contacts, breakage; docs/decisions.md#d44)\n"
     "  --window COLUMN=LO:HI: the differences over REFERENCE's rows whose COLUMN (time or a shared\n"
     "  sensor) lies in [LO, HI], OTHER's peak over its own such rows; e.g. the DCB's Delta=0.5e-3:2.0e-3\n"
-    "  (docs/decisions.md#d51); the plots keep the whole histories\n"
+    "  (docs/decisions.md#d51); the plots draw the whole histories against COLUMN\n"
     "  --set applies to both cases, --set-reference and --set-other (after it) to one: e.g. the\n"
     "  coupled case with --set-other continuum.solver=nem against a pure DEM, which has no continuum\n";
 

@@ -217,8 +217,9 @@ TEST(Cli, CompareSetsEachCaseApart) {
 
 // compare --window COLUMN=LO:HI judges the reference's rows whose COLUMN lies in [LO, HI] only
 // (docs/decisions.md#d51): the chain against itself less damped, over the middle of its run, gives
-// the figures computed here from the two series over those rows, not those of the whole run. A
-// window on no column of both runs, or not of the form COLUMN=LO:HI, is refused before any run.
+// the figures computed here from the two series over those rows, not those of the whole run; its
+// plots are drawn against the window's column. A window on no column of both runs, or not of the
+// form COLUMN=LO:HI, is refused before any run.
 TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
   const auto out = test::scratch_dir("compare_window");
   const std::string pair = "compare " + cases + "cantilever_chain/case.yaml " + cases + "cantilever_chain/case.yaml "
@@ -254,6 +255,16 @@ TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
   ASSERT_GT(std::abs(expected / whole - 1), 0.05);  // the window changes the figure
   ASSERT_EQ(c.at("sensors").at(0).at("sensor").get<std::string>(), "tip_deflection");
   EXPECT_NEAR(c.at("sensors").at(0).at("max_relative_difference").get<double>(), expected, 1e-9 * expected);
+  // A window on a sensor column that holds every row: the whole run's figure, and the plots drawn
+  // against that column (the other sensor's only).
+  const auto along = test::run_arlequin(pair + " --window tip_deflection=-1:1", "stdout");
+  ASSERT_EQ(along.exit_code, 0) << along.output;
+  EXPECT_NEAR(read_json_file(out / "compare.json").at("sensors").at(0).at("max_relative_difference").get<double>(), whole,
+              1e-9 * whole);
+  const Json plots = read_json_file(out / "plots.json").at("plots");
+  ASSERT_EQ(plots.size(), 1u);
+  EXPECT_EQ(plots.at(0).at("x_label").get<std::string>(), "tip_deflection [m]");
+  EXPECT_EQ(plots.at(0).at("y_label").get<std::string>(), "clamp_reaction [N]");
 
   for (const auto& [window, message] : std::vector<std::pair<std::string, std::string>>{
            {"tip_deflection", "--window 'tip_deflection': expected COLUMN=LO:HI with numbers LO <= HI"},
