@@ -275,11 +275,10 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   if (!window.column.empty()) {
     const auto inside = rows_inside(a, window);
     const auto rows = std::count(inside.begin(), inside.end(), true);
-    if (rows == 0)
-      throw InputError("--window " + window.column + "=...: no row of " + a.name + "'s series.csv has " + window.column + " in [" +
-                       std::to_string(window.low) + ", " + std::to_string(window.high) + "]");
-    std::printf("over the rows of %s with %s in [%g, %g]: %ld of %zu\n", a.name.c_str(), window.column.c_str(), window.low,
-                window.high, long(rows), inside.size());
+    char range[128];
+    std::snprintf(range, sizeof range, "%s in [%g, %g]", window.column.c_str(), window.low, window.high);
+    if (rows == 0) throw InputError("--window " + window.column + "=...: no row of " + a.name + "'s series.csv has " + range);
+    std::printf("over the rows of %s with %s: %ld of %zu\n", a.name.c_str(), range, long(rows), inside.size());
   }
 
   Json sensors = Json::array();

@@ -278,6 +278,11 @@ TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
     EXPECT_NE(bad.output.find(message), std::string::npos) << bad.output;
     EXPECT_FALSE(std::filesystem::exists(bad_out / "reference" / "series.csv"));
   }
+  // A window beyond the runs is found once they have run: no figure over no row.
+  const auto empty = test::run_arlequin(pair + " --window time=1:2");
+  EXPECT_EQ(empty.exit_code, 2) << empty.output;
+  EXPECT_NE(empty.output.find("--window time=...: no row of cantilever_chain's series.csv has time in [1, 2]"), std::string::npos)
+      << empty.output;
 }
 
 // --out must name a folder that can be written: refused before the run, as bad input. `check`
