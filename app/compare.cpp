@@ -273,12 +273,16 @@ CompareOutcome run_compare(const std::filesystem::path& reference_case, const st
   const Run& b = other_runs[0];
   const std::size_t pairs = reference_runs.size();
   if (!window.column.empty()) {
-    const auto inside = rows_inside(a, window);
-    const auto rows = std::count(inside.begin(), inside.end(), true);
     char range[128];
     std::snprintf(range, sizeof range, "%s in [%g, %g]", window.column.c_str(), window.low, window.high);
-    if (rows == 0) throw InputError("--window " + window.column + "=...: no row of " + a.name + "'s series.csv has " + range);
-    std::printf("over the rows of %s with %s: %ld of %zu\n", a.name.c_str(), range, long(rows), inside.size());
+    const auto rows_in = [&window](const Run& r) {
+      const auto inside = rows_inside(r, window);
+      return long(std::count(inside.begin(), inside.end(), true));
+    };
+    for (const auto* runs : {&reference_runs, &other_runs})
+      for (const Run& r : *runs)
+        if (rows_in(r) == 0) throw InputError("--window " + window.column + "=...: no row of " + r.name + "'s series.csv has " + range);
+    std::printf("over the rows of %s with %s: %ld of %zu\n", a.name.c_str(), range, rows_in(a), a.rows.size());
   }
 
   Json sensors = Json::array();

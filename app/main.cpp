@@ -89,9 +89,9 @@ constexpr const char* usage_compare =
     "  --ensemble N: N pairs, pair k = 0..N-1 with both time steps x (1 - k 1e-9) (results of k >= 1 in\n"
     "  DIR/pair_k/): the median and range over the pairs, and the reference's own spread; for runs\n"
     "  whose outcome is a draw (contacts, breakage; docs/decisions.md#d44)\n"
-    "  --window COLUMN=LO:HI: the differences over REFERENCE's rows whose COLUMN (time or a shared\n"
-    "  sensor) lies in [LO, HI], OTHER's peak over its own such rows; e.g. the DCB's Delta=0.5e-3:2.0e-3\n"
-    "  (docs/decisions.md#d51); the plots draw the whole histories against COLUMN\n"
+    "  --window COLUMN=LO:HI: the differences and peaks over the rows whose COLUMN (time or a shared\n"
+    "  sensor) lies in [LO, HI] (OTHER at REFERENCE's times there, and its own rows for its peak); e.g.\n"
+    "  the DCB's Delta=0.5e-3:2.0e-3 (docs/decisions.md#d51); the plots draw the whole histories against COLUMN\n"
     "  --set applies to both cases, --set-reference and --set-other (after it) to one: e.g. the\n"
     "  coupled case with --set-other continuum.solver=nem against a pure DEM, which has no continuum\n";
 

@@ -228,24 +228,22 @@ TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
   const auto r = test::run_arlequin(pair + " --window time=5e-4:1.5e-3", "stdout");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto a = test::read_csv(out / "reference" / "series.csv"), b = test::read_csv(out / "other" / "series.csv");
-  // b's deflection at time t, linear between its rows (its damping changes its step and output times).
-  const auto b_at = [&b](double t) {
-    std::size_t k = 1;
-    while (k + 1 < b.size() && test::number(b[k], "time") < t) ++k;
-    const double t0 = test::number(b[k - 1], "time"), t1 = test::number(b[k], "time");
-    const double s = std::clamp((t - t0) / (t1 - t0), 0.0, 1.0);
-    return (1 - s) * test::number(b[k - 1], "tip_deflection") + s * test::number(b[k], "tip_deflection");
-  };
-  double max_diff = 0, max_ref = 0, whole_diff = 0, whole_ref = 0;
+  // b's deflection at a's output times (its damping changes its step and output times), linear
+  // between its rows; b's peak over its own rows in the window.
+  double max_diff = 0, max_ref = 0, sum_diff = 0, sum_ref = 0, whole_diff = 0, whole_ref = 0, b_peak = 0;
   int rows = 0;
   for (std::size_t k = 0; k < a.size(); ++k) {
     const double t = test::number(a[k], "time"), va = test::number(a[k], "tip_deflection");
-    const double d = std::abs(b_at(t) - va);
+    const double d = std::abs(test::value_at(b, "time", t, "tip_deflection") - va);
     whole_diff = std::max(whole_diff, d), whole_ref = std::max(whole_ref, std::abs(va));
     if (t < 5e-4 || t > 1.5e-3) continue;
     ++rows;
     max_diff = std::max(max_diff, d), max_ref = std::max(max_ref, std::abs(va));
+    sum_diff += d * d, sum_ref += va * va;
   }
+  for (const auto& row : b)
+    if (const double t = test::number(row, "time"); 5e-4 <= t && t <= 1.5e-3)
+      b_peak = std::max(b_peak, std::abs(test::number(row, "tip_deflection")));
   ASSERT_GE(rows, 19);
   EXPECT_NE(r.output.find("over the rows of cantilever_chain with time in [0.0005, 0.0015]: " + std::to_string(rows) + " of"),
             std::string::npos) << r.output;
@@ -255,6 +253,10 @@ TEST(Cli, CompareOverAWindowJudgesItsRowsOnly) {
   ASSERT_GT(std::abs(expected / whole - 1), 0.05);  // the window changes the figure
   ASSERT_EQ(c.at("sensors").at(0).at("sensor").get<std::string>(), "tip_deflection");
   EXPECT_NEAR(c.at("sensors").at(0).at("max_relative_difference").get<double>(), expected, 1e-9 * expected);
+  const double rms = std::sqrt(sum_diff / sum_ref), peak = (b_peak - max_ref) / max_ref;
+  EXPECT_NEAR(c.at("sensors").at(0).at("rms_relative_difference").get<double>(), rms, 1e-9 * rms);
+  EXPECT_NEAR(c.at("sensors").at(0).at("peak_relative_difference").get<double>(), peak, 1e-9 * std::abs(peak));
+  EXPECT_EQ(read_json_file(out / "plots.json").at("plots").at(0).at("x_label").get<std::string>(), "time [s]");
   // A window on a sensor column that holds every row: the whole run's figure, and the plots drawn
   // against that column (the other sensor's only).
   const auto along = test::run_arlequin(pair + " --window tip_deflection=-1:1", "stdout");

@@ -3,6 +3,7 @@
 #pragma once
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -65,6 +66,17 @@ inline std::vector<std::map<std::string, std::string>> read_csv(const std::files
 }
 inline double number(const std::map<std::string, std::string>& row, const std::string& column) {
   return std::stod(row.at(column));
+}
+
+// `column` of CSV rows where the column `along` (increasing down the rows) equals x, linear between
+// rows, held beyond the first and last rows.
+inline double value_at(const std::vector<std::map<std::string, std::string>>& rows, const std::string& along, double x,
+                       const std::string& column) {
+  std::size_t k = 1;
+  while (k + 1 < rows.size() && number(rows[k], along) < x) ++k;
+  const double x0 = number(rows[k - 1], along), x1 = number(rows[k], along);
+  const double s = std::clamp((x - x0) / (x1 - x0), 0.0, 1.0);
+  return (1 - s) * number(rows[k - 1], column) + s * number(rows[k], column);
 }
 
 }  // namespace arlequin::test
