@@ -150,7 +150,8 @@ struct Difference {
 };
 
 Difference difference(const Run& a, const Run& b, const std::string& name, const CompareWindow& window) {
-  const auto va = a.column(name), vb = resample(b.column("time"), b.column(name), a.column("time"));
+  const auto own = b.column(name);  // at its own rows: for its peak, not resampled
+  const auto va = a.column(name), vb = resample(b.column("time"), own, a.column("time"));
   const auto in_a = rows_inside(a, window), in_b = rows_inside(b, window);
   double max_diff = 0, max_ref = 0, max_other = 0, sum_diff = 0, sum_ref = 0;
   for (std::size_t k = 0; k < va.size(); ++k) {
@@ -161,7 +162,6 @@ Difference difference(const Run& a, const Run& b, const std::string& name, const
     sum_diff += d * d;
     sum_ref += va[k] * va[k];
   }
-  const auto own = b.column(name);  // its own peak, not resampled
   for (std::size_t k = 0; k < own.size(); ++k)
     if (in_b[k]) max_other = std::max(max_other, std::abs(own[k]));
   const double ref = std::max(max_ref, 1e-300);

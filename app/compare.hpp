@@ -52,8 +52,8 @@ inline constexpr double ensemble_time_step_perturbation = 1e-9;
 // ensemble > 1, the further pairs after them (each pair's scenes built just before it runs).
 // Pair 0 writes to out_dir/reference and out_dir/other, pair k to out_dir/pair_k/... InputError,
 // before any run, when a case is bad, the cases share no sensor column, or an ensemble is asked
-// of two static solves, or the window's column is not one of both runs (after the runs, when no row
-// of the reference lies in the window). With an ensemble, compare.json's "reference" and "other" and the runs'
+// of two static solves, or the window's column is not one of both runs (after the runs, when a run
+// of any pair has no row in the window). With an ensemble, compare.json's "reference" and "other" and the runs'
 // printed sizes and energies are pair 0's; every difference and the speed-up are medians (the
 // first break's under "ensemble", with each pair's).
 CompareOutcome run_compare(const std::filesystem::path& reference_case, const std::filesystem::path& other_case,
