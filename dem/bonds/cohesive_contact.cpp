@@ -129,31 +129,32 @@ CohesiveContactSet::Evaluation CohesiveContactSet::evaluate(std::size_t b, const
   const double mix = lambda2 > 0.0 ? s2 / lambda2 : 0.0;  // B
   const double lambda0 =
       lambda2 > 0.0 ? dn0 * ds0 * std::sqrt(lambda2 / (ds0 * ds0 * opening * opening + dn0 * dn0 * s2)) : dn0;
-  const double toughness = q.toughness_I + (q.toughness_II - q.toughness_I) * std::pow(mix, q.bk_exponent);
-  const double lambda_f = std::max(2.0 * toughness / (k * lambda0), lambda0 * (1.0 + 1e-12));
-
   const double stored = damage_[b];
-  double trial = 0.0;
-  if (lambda >= lambda_f) trial = 1.0;
-  else if (lambda > lambda0) trial = lambda_f * (lambda - lambda0) / (lambda * (lambda_f - lambda0));
-  const double damage = std::max(stored, trial);
-
-  // Fraction of G_c S dissipated once the damage is d, along this mix.
-  const auto dissipated_fraction = [&](double dmg) {
-    const double reached = lambda0 * lambda_f / (lambda_f - dmg * (lambda_f - lambda0));
-    return (reached - lambda0) / (lambda_f - lambda0);
-  };
-  Evaluation e;
+  double damage = stored, dissipation = 0.0;
   const double K = stiffness_[b];
+  // Below the onset opening the damage stays as it is and nothing is dissipated: the mixed-mode
+  // toughness (a pow) and the failure opening are needed only beyond it, in the process zone.
+  if (lambda > lambda0) {
+    const double toughness = q.toughness_I + (q.toughness_II - q.toughness_I) * std::pow(mix, q.bk_exponent);
+    const double lambda_f = std::max(2.0 * toughness / (k * lambda0), lambda0 * (1.0 + 1e-12));
+    const double trial = lambda >= lambda_f ? 1.0 : lambda_f * (lambda - lambda0) / (lambda * (lambda_f - lambda0));
+    damage = std::max(stored, trial);
+    // Fraction of G_c S dissipated once the damage is d, along this mix.
+    const auto dissipated_fraction = [&](double dmg) {
+      const double reached = lambda0 * lambda_f / (lambda_f - dmg * (lambda_f - lambda0));
+      return (reached - lambda0) / (lambda_f - lambda0);
+    };
+    if (damage > stored && K > 0.0)
+      dissipation = toughness * section_[b] * (dissipated_fraction(damage) - dissipated_fraction(stored));
+  }
+  Evaluation e;
   e.force_on_j = (us + n * opening) * (-K * (1.0 - damage)) + n * (K * closing);
   e.torque_on_i = cross(arm_i, -e.force_on_j);
   e.torque_on_j = cross(arm_j, e.force_on_j);
   e.damage = damage;
   e.mode_mix = mix;
   e.elastic = 0.5 * K * ((1.0 - damage) * lambda2 + closing * closing);
-  e.dissipation = damage > stored && K > 0.0
-                      ? toughness * section_[b] * (dissipated_fraction(damage) - dissipated_fraction(stored))
-                      : 0.0;
+  e.dissipation = dissipation;
   return e;
 }
 
