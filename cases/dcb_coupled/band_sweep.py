@@ -11,22 +11,25 @@ overlap's width (cases/dcb_coupled/README.md): error against run time.
     PYTHONPATH=python python3 cases/dcb_coupled/band_sweep.py results/dcb_band_pure results/dcb_band_sweep
 
 (time.end = 2.1 ms: the load lines have opened by Delta = 2.0 mm, the end of the comparison.)
-These sweep the case itself (40k DEs). The README's table is at 20k (docs/decisions.md#d46): both
+These sweep the case itself (40k DEs). Runs of the case made elsewhere (the validation tests'
+pure DEM and coupled DCB, which run to the case's 2.6 ms) may stand in for the pure run and be
+added after the sweep folder as further run folders. At 20k DEs (docs/decisions.md#d46) both
 commands also take --set dem.sample.radius.mean=1.75e-4 --set dem.sample.file=$PWD/results/dcb_band_20k.h5
 (one packing for all the runs: an absolute path, as a relative one is read from each case's own
-folder), the pure run the 20k load lines, --set "groups=$G" with G the third
-entry of cases/dcb/sweep_groups.txt, and the sweep --set coupling.continuum_substeps=3 and the
-20k arm's bending modulus, --set continuum.material.E=9.8e10 (cases/dcb/README.md; the README's
-table was measured before the case took the arms' bending modulus, at 135 GPa, and with P1 arms:
---set continuum.mesh.file=../../meshes/dcb_arms.geo --set continuum.mesh.order=1 reproduces them;
-docs/decisions.md#d47, #d48).
+folder), the pure run the 20k load lines, --set "groups=$G" with G the third entry of
+cases/dcb/sweep_groups.txt, and the sweep the 20k arm's bending modulus, --set
+continuum.material.E=9.8e10 (cases/dcb/README.md).
+
 For each run: the band (half-thickness and overlap width, from its resolved case), its DEs and the
-continuum's degrees of freedom, the time loop's wall time, and against the pure-DEM run: P(Delta)
-(the largest |P / P_pure - 1| over Delta in [0.5, 2.0] mm, P_pure interpolated at the run's
-Delta), the peak load, and the interface's dissipated energy at Delta = 2.0 mm; and P against
-LEFM (R5: the largest |P / P_LEFM - 1| over Delta in [0.75, 2.0] mm, from the run's own check).
-The pure run is the table's first row. Prints a Markdown table and writes band_sweep.csv and
-band_sweep.png (P error against wall time) into the sweep folder.
+continuum's degrees of freedom, and its compute time (the time loop less its output) brought to
+the earliest end time of the runs compared (a step costs about the same all along a run), and
+against the pure-DEM run, over its rows with Delta in [0.5, 2.0] mm, the run's load at their
+times (both impose the same Delta(t)): the load as docs/decisions.md#d51 compares it,
+max |P - P_pure| / max P_pure, and row by row, max |P / P_pure - 1|; the peak load, and the
+interface's dissipated energy at Delta = 2.0 mm; and P against LEFM (R5: the largest
+|P / P_LEFM - 1| over Delta in [0.75, 2.0] mm, from the run's own check). The pure run is the
+table's first row. Prints a Markdown table and writes band_sweep.csv and band_sweep.png (the
+load's and the energy's difference against compute time) into the sweep folder.
 """
 
 import sys
@@ -39,21 +42,34 @@ import arlequin
 COMPARED = (0.5e-3, 2.0e-3)  # m, the Delta range of the comparison (the issue's)
 
 
-def band_of(run):
-    """(half-thickness, overlap width) of the band in mm, from the resolved case's band entry (a
-    block of indented "key: value" lines); None for a run without a band."""
+def section_of(run, name):
+    """The "key: value" entries directly under the first line "name:" of the run's resolved case
+    (a block of indented lines; nested blocks' own entries left out), as strings; None if absent."""
     lines = (run.path / "case.resolved.yaml").read_text().splitlines()
     for k, line in enumerate(lines):
-        if line.strip() == "band:":
+        if line.strip() == f"{name}:":
             indent = len(line) - len(line.lstrip())
-            fields = {}
+            fields, child = {}, None
             for entry in lines[k + 1:]:
-                if len(entry) - len(entry.lstrip()) <= indent:
+                depth = len(entry) - len(entry.lstrip())
+                if depth <= indent:
                     break
-                key, value = entry.strip().split(":", 1)
-                fields[key] = value.strip()
-            return 1e3 * float(fields["half_thickness"]), 1e3 * float(fields["width"])
+                child = depth if child is None else child
+                if depth == child and ":" in entry:
+                    key, value = entry.strip().split(":", 1)
+                    fields[key] = value.strip()
+            return fields
     return None
+
+
+def label_of(run):
+    """"pure DEM", or the band's half-thickness / overlap width in mm and, if not fe, the solver."""
+    band = section_of(run, "band")
+    if band is None:
+        return "pure DEM"
+    label = f"{1e3 * float(band['half_thickness']):.2f} / {1e3 * float(band['width']):.2f} mm"
+    solver = section_of(run, "continuum")["solver"]
+    return label if solver == "fe" else f"{label}, {solver}"
 
 
 def lefm_error(run):
@@ -65,21 +81,27 @@ def lefm_error(run):
     return float("nan")
 
 
-def row_of(run, pure):
+def compute_seconds(run, until):
+    """The run's time loop less its output, brought from its end time to `until` (s)."""
+    wall = run.summary["wall_time"]
+    return (wall["time_loop"] - wall["output"]) * until / run.series["time"].iloc[-1]
+
+
+def row_of(run, pure, until):
     s, p = run.series, pure.series
-    delta, load = s["Delta"].to_numpy(), s["P"].to_numpy()
-    inside = (delta >= COMPARED[0]) & (delta <= COMPARED[1])
-    pure_load = np.interp(delta[inside], p["Delta"].to_numpy(), p["P"].to_numpy())
-    energy = np.interp(COMPARED[1], delta, s["E_interface"].to_numpy())
+    inside = (p["Delta"] >= COMPARED[0]) & (p["Delta"] <= COMPARED[1])
+    pure_load = p["P"][inside].to_numpy()
+    load = np.interp(p["time"][inside].to_numpy(), s["time"].to_numpy(), s["P"].to_numpy())
+    energy = np.interp(COMPARED[1], s["Delta"].to_numpy(), s["E_interface"].to_numpy())
     pure_energy = np.interp(COMPARED[1], p["Delta"].to_numpy(), p["E_interface"].to_numpy())
     counts = run.summary["counts"]
-    band = band_of(run)
     return {
-        "run": "pure DEM" if band is None else f"{band[0]:.2f} / {band[1]:.2f} mm",
+        "run": label_of(run),
         "des": counts["particles"],
         "continuum_dofs": 3 * counts.get("continuum_nodes", 0),
-        "wall_s": run.summary["wall_time"]["time_loop"],
-        "P_max_rel": float(np.max(np.abs(load[inside] / pure_load - 1.0))),
+        "wall_s": compute_seconds(run, until),
+        "P_rel": float(np.max(np.abs(load - pure_load)) / np.max(np.abs(pure_load))),
+        "P_row_rel": float(np.max(np.abs(load / pure_load - 1.0))),
         "peak_rel": float(s[s["Delta"] <= COMPARED[1]]["P"].max() / p[p["Delta"] <= COMPARED[1]]["P"].max() - 1.0),
         "energy_rel": float(energy / pure_energy - 1.0),
         "lefm_max_rel": lefm_error(run),
@@ -87,24 +109,30 @@ def row_of(run, pure):
 
 
 def main(argv):
-    if len(argv) != 3:
+    if len(argv) < 3:
         raise SystemExit(__doc__)
     pure = arlequin.load(Path(argv[1]))
     sweep_dir = Path(argv[2])
-    runs = arlequin.load_sweep(sweep_dir)
-    rows = [row_of(pure, pure)] + [row_of(r, pure) for r in runs]
-    header = ["band: half-thickness / overlap", "DEs", "continuum dofs", "wall [s]", "speed-up",
-              "P: max rel. over [0.5, 2] mm", "peak load", "interface energy at 2 mm", "P vs LEFM (R5)"]
+    runs = sorted(arlequin.load_sweep(sweep_dir) + [arlequin.load(Path(a)) for a in argv[3:]],
+                  key=lambda r: (r.summary["counts"]["particles"], label_of(r)))
+    until = min(r.series["time"].iloc[-1] for r in [pure] + runs)
+    if pure.series["Delta"].max() < COMPARED[1] or until < pure.series["time"][pure.series["Delta"] <= COMPARED[1]].max():
+        raise SystemExit(f"a run ends before Delta = {1e3 * COMPARED[1]:g} mm: run them to time.end = 2.1e-3 or later")
+    rows = [row_of(pure, pure, until)] + [row_of(r, pure, until) for r in runs]
+    header = ["band: half-thickness / overlap", "DEs", "continuum dofs", f"compute [s] to {1e3 * until:g} ms",
+              "speed-up", "P: max diff. / max P_pure", "P: row by row", "peak load", "interface energy at 2 mm",
+              "P vs LEFM (R5)"]
     print(arlequin.markdown_table(header, [
         [r["run"], r["des"], r["continuum_dofs"], f"{r['wall_s']:.0f}", f"{rows[0]['wall_s'] / r['wall_s']:.2f}x",
-         f"{100 * r['P_max_rel']:.1f} %", f"{100 * r['peak_rel']:+.1f} %", f"{100 * r['energy_rel']:+.1f} %",
-         f"{100 * r['lefm_max_rel']:.1f} %"] for r in rows]))
+         f"{100 * r['P_rel']:.2f} %", f"{100 * r['P_row_rel']:.2f} %", f"{100 * r['peak_rel']:+.2f} %",
+         f"{100 * r['energy_rel']:+.2f} %", f"{100 * r['lefm_max_rel']:.2f} %"] for r in rows]))
     arlequin.write_table(sweep_dir / "band_sweep.csv", rows)
 
     arlequin.plot_error_against_time(sweep_dir / "band_sweep.png", rows[0], rows[1:],
-                                     [("coupled: P(Delta)", "P_max_rel", "o"),
+                                     [("coupled: P(Delta), max diff. / max P_pure", "P_rel", "o"),
                                       ("coupled: interface energy at 2 mm", "energy_rel", "s")],
-                                     "Coupled DCB against pure DEM, over the DEM band", "|difference| from the pure DEM [%]")
+                                     "Coupled DCB against pure DEM, over the DEM band", "|difference| from the pure DEM [%]",
+                                     xlabel=f"compute time to t = {1e3 * until:g} ms (time loop less output) [s]")
 
 
 if __name__ == "__main__":

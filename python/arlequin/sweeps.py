@@ -24,11 +24,12 @@ def markdown_table(header, rows):
     return "\n".join(lines)
 
 
-def plot_error_against_time(path, pure, coupled, curves, title, ylabel, gate=5.0):
+def plot_error_against_time(path, pure, coupled, curves, title, ylabel, gate=5.0,
+                            xlabel="wall time of the run's time loop [s]"):
     """Draws, for each of `curves` ((legend, key, marker) triples), the coupled rows' row[key] in
     per cent against their wall time (row["wall_s"]), each point of the first curve annotated with
     its row["run"] and row["des"]; the pure row's wall time as a dashed line and `gate` per cent as
-    a dotted one. Saves the figure at `path`."""
+    a dotted one; `xlabel` says what the wall times are. Saves the figure at `path`."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -43,7 +44,7 @@ def plot_error_against_time(path, pure, coupled, curves, title, ylabel, gate=5.0
         ax.annotate(f"{r['run']} ({r['des']} DEs)", (r["wall_s"], 100 * abs(r[first_key])), fontsize=8)
     ax.axvline(pure["wall_s"], color="k", ls="--", label=f"pure DEM ({pure['des']} DEs)")
     ax.axhline(gate, color="r", ls=":", label=f"{gate:g} %")
-    ax.set_xlabel("wall time of the run's time loop [s]")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)
     ax.legend(fontsize=8)
