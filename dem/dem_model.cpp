@@ -323,11 +323,11 @@ double DemModel::driven_kinetic_energy() const {
 void DemModel::drift(double dt) {
   ParticleSet& p = particles;
   const long n = static_cast<long>(p.size());
-  for_each_index(n, n > parallel_threshold, [&p, dt](long i) {
-    p.position[i] += p.velocity[i] * dt;
-    // Spheres: omega is constant over the drift, so the rotation is exact.
-    if (norm2(p.angular_velocity[i]) > 0.0)
-      p.orientation[i] = renormalized(from_rotation_vector(p.angular_velocity[i] * dt) * p.orientation[i]);
+  // Each thread its share, in vector lanes: a DE's bits do not depend on the DEs that share its
+  // lanes (ParticleSet::drift), so not on the thread count.
+  run_threaded_if(n > parallel_threshold, [&p, n, dt] {
+    const IndexRange share = thread_share(n);
+    p.drift(share.begin, share.end, dt);
   });
   // For the force pass, in a pass of its own: inside the loop above, its stores took most of the
   // drift's time (docs/performance.md#clearing-forces).

@@ -37,6 +37,11 @@ struct ParticleSet {
   double inv_inertia(std::size_t i) const { return inv_mass[i] / (0.4 * radius[i] * radius[i]); }
   double inertia(std::size_t i) const { return 1.0 / inv_inertia(i); }
   void clear_forces();
+  // The drift of DEs [begin, end) over dt: x += dt v, and q = exp(dt omega) q renormalised
+  // (omega is constant over the drift of a sphere, so the rotation is exact). Eight DEs at a
+  // time, one a vector lane: a DE's new position and orientation have the same bits whichever
+  // DEs share its block (so on any thread count, and alone).
+  void drift(long begin, long end, double dt);
   void reserve(std::size_t n);
   // Drops every DE i with keep(i) false, keeping the order of the others; returns how many
   // were dropped. Only before bonds, groups or boundary conditions refer to DE indices.

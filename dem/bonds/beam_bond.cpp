@@ -9,57 +9,20 @@
 #include <numbers>
 #include <stdexcept>
 
-#if defined(__AVX512F__)
-// GCC 12's _mm512_sqrt_pd starts from _mm512_undefined_pd: a false -Wuninitialized (or
-// -Wmaybe-uninitialized, by where it is inlined).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <immintrin.h>
-#pragma GCC diagnostic pop
-#endif
-
 #include "common/case_file.hpp"
+#include "dem/lanes.hpp"
 
 namespace arlequin::dem {
 
 template class BondKernelSet<BeamBondSet>;
 namespace {
 
-// The kinematics of BeamBondSet::block bonds at once, one bond per lane of a GCC vector (one
-// AVX-512 register; the compiler splits it on narrower CPUs): the Vec3 algebra of
-// common/vec3.hpp and quat.hpp, lane by lane. Every bond, alone or in a block, goes through
-// this one kernel, so a bond's actions do not depend on the bonds it is evaluated with.
-constexpr std::size_t lanes = BeamBondSet::block;
-using Lanes = double __attribute__((vector_size(lanes * sizeof(double))));
+// The kinematics of BeamBondSet::block bonds at once, one bond per lane (dem/lanes.hpp). Every
+// bond, alone or in a block, goes through this one kernel, so a bond's actions do not depend on
+// the bonds it is evaluated with.
+using namespace simd;
+static_assert(BeamBondSet::block == lanes);
 
-struct LaneVec {
-  Lanes x, y, z;
-};
-struct LaneQuat {
-  Lanes w;
-  LaneVec v;
-};
-inline LaneVec operator+(const LaneVec& a, const LaneVec& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline LaneVec operator-(const LaneVec& a, const LaneVec& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline LaneVec operator*(const LaneVec& a, Lanes s) { return {a.x * s, a.y * s, a.z * s}; }
-inline LaneVec operator*(Lanes s, const LaneVec& a) { return a * s; }
-inline LaneVec operator*(double s, const LaneVec& a) { return {a.x * s, a.y * s, a.z * s}; }
-inline Lanes dot(const LaneVec& a, const LaneVec& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-inline LaneVec cross(const LaneVec& a, const LaneVec& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-// R(q) a = a + 2w (v x a) + 2 v x (v x a), as common/quat.hpp's rotate: with t = (2 v) x a (2 v
-// exact, shared by the rotations with one q), each component a + w t + v x t as three fused
-// multiply-adds, not a product, a cross product and two sums.
-inline LaneVec rotate(const LaneQuat& q, const LaneVec& a) {
-  const LaneVec& v = q.v;
-  const LaneVec t = cross(v + v, a);
-  return {a.x + q.w * t.x + v.y * t.z - v.z * t.y,  //
-          a.y + q.w * t.y + v.z * t.x - v.x * t.z,  //
-          a.z + q.w * t.z + v.x * t.y - v.y * t.x};
-}
-using LaneMask = decltype(Lanes{} < Lanes{});
 inline Lanes lane_sqrt(Lanes x) {
 #if defined(__AVX512F__)
   static_assert(lanes == 8);
@@ -96,45 +59,7 @@ inline Lanes inverse_sqrt(Lanes x) {
   return 1.0 / lane_sqrt(x);
 #endif
 }
-// Whether every lane of m is set: the test that lets a block skip the rare lanes' loops.
-inline bool every_lane(LaneMask m) {
-#if defined(__AVX512F__)
-  return _mm512_test_epi64_mask(__m512i(m), __m512i(m)) == 0xff;
-#else
-  for (std::size_t l = 0; l < lanes; ++l)
-    if (!m[l]) return false;
-  return true;
-#endif
-}
 
-// Eight quaternions (w, x, y, z) as one LaneQuat: a 4 x 8 transpose, shuffles only (pairs side
-// by side, then two rounds).
-static_assert(sizeof(Quat) == 4 * sizeof(double));
-using Quad = double __attribute__((vector_size(4 * sizeof(double))));
-inline LaneQuat transpose(const Quad (&q)[lanes]) {
-  // Pairs side by side: p[k] = (q[2k], q[2k+1]) = w x y z w x y z.
-  Lanes p[4];
-  for (int k = 0; k < 4; ++k) p[k] = __builtin_shufflevector(q[2 * k], q[2 * k + 1], 0, 1, 2, 3, 4, 5, 6, 7);
-  // Round 1: from two pairs, (w, x) and (y, z) of four quaternions.
-  const Lanes wx01 = __builtin_shufflevector(p[0], p[1], 0, 1, 4, 5, 8, 9, 12, 13);
-  const Lanes yz01 = __builtin_shufflevector(p[0], p[1], 2, 3, 6, 7, 10, 11, 14, 15);
-  const Lanes wx23 = __builtin_shufflevector(p[2], p[3], 0, 1, 4, 5, 8, 9, 12, 13);
-  const Lanes yz23 = __builtin_shufflevector(p[2], p[3], 2, 3, 6, 7, 10, 11, 14, 15);
-  // Round 2: every other element.
-  return {__builtin_shufflevector(wx01, wx23, 0, 2, 4, 6, 8, 10, 12, 14),
-          {__builtin_shufflevector(wx01, wx23, 1, 3, 5, 7, 9, 11, 13, 15),
-           __builtin_shufflevector(yz01, yz23, 0, 2, 4, 6, 8, 10, 12, 14),
-           __builtin_shufflevector(yz01, yz23, 1, 3, 5, 7, 9, 11, 13, 15)}};
-}
-
-// A position (x, y, z, 0) as one vector: a masked load, which reads nothing past z.
-inline Quad load_position(const Vec3& x) {
-#if defined(__AVX512F__)
-  return _mm256_maskz_loadu_pd(0x7, &x.x);
-#else
-  return Quad{x.x, x.y, x.z, 0.0};
-#endif
-}
 
 // The series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
 // (2.9 degrees, where bonds live) it is exact to 5e-12 relative and costs a tenth of libm's

@@ -38,6 +38,49 @@ TEST(FreeMotion, FlightAndSpinAreExact) {
   EXPECT_NEAR(norm2(model.particles.orientation[0].v) + std::pow(model.particles.orientation[0].w, 2), 1.0, 1e-15);
 }
 
+// The drift takes DEs eight at a time, one a vector lane: a DE's new position and orientation
+// must not depend on the DEs beside it (its bits: the threads split the DEs differently), and
+// must be the exact free flight and rotation. Three blocks and a tail of three: some DEs without
+// spin (their orientation is left as it is), one beyond the rotation vector's series, and a block
+// whose only turning DE is its last, about z (the block's last double of omega: a block that
+// seemed not to turn would leave it as it was).
+// Bounds: 50 steps of round-off on coordinates of order 1 (an ulp is 2.2e-16) and on a unit
+// quaternion.
+TEST(FreeMotion, DesDriftTheSameInABlockAndAlone) {
+  ParticleSet blocks;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 27;
+  const double dt = 1e-4;
+  for (int i = 0; i < n; ++i) {
+    blocks.add({u(rng), u(rng), u(rng)}, 1e-3, steel);
+    blocks.velocity[i] = {u(rng), u(rng), u(rng)};
+    if (i % 5 != 2) blocks.angular_velocity[i] = Vec3{u(rng), u(rng), u(rng)} * 40.0;  // |omega| dt < 7e-3 rad
+    blocks.orientation[i] = from_rotation_vector({3 * u(rng), 3 * u(rng), 3 * u(rng)});
+  }
+  blocks.angular_velocity[11] = {0.0, 200.0, 0.0};  // 2e-2 rad a step: beyond the series (1e-2)
+  for (int i = 16; i < 23; ++i) blocks.angular_velocity[i] = {};
+  blocks.angular_velocity[23] = {0.0, 0.0, 50.0};
+  ParticleSet alone = blocks;
+  const ParticleSet start = blocks;
+  const int steps = 50;
+  for (int step = 0; step < steps; ++step) {
+    blocks.drift(0, n, dt);
+    for (int i = 0; i < n; ++i) alone.drift(i, i + 1, dt);
+  }
+  const Vec3 a{0.3, 0.4, -0.5};
+  for (int i = 0; i < n; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(blocks.position[i], alone.position[i]);
+    EXPECT_EQ(blocks.orientation[i].w, alone.orientation[i].w);
+    EXPECT_EQ(blocks.orientation[i].v, alone.orientation[i].v);
+    const Vec3 w = blocks.angular_velocity[i];
+    const Vec3 exact = rotate(from_rotation_vector(w * (steps * dt)), rotate(start.orientation[i], a));
+    EXPECT_LT(norm(rotate(blocks.orientation[i], a) - exact), 2e-14);
+    EXPECT_LT(norm(blocks.position[i] - (start.position[i] + start.velocity[i] * (steps * dt))), 2e-14);
+  }
+}
+
 // Two touching DEs of radius R = 1 mm joined by one beam; omega_axial = sqrt(2 k / m) for the
 // two equal masses on the axial spring k = E S / L0.
 struct BondedPair : ::testing::Test {
