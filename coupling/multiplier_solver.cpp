@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "coupling/multiplier_solver.hpp"
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -12,13 +14,32 @@ namespace arlequin::coupling {
 
 namespace {
 
+// A row of the solve's scratch: a vector of 2 or 4 doubles, at a double's alignment (the
+// vector's own may exceed the allocation's). Spelled per size: GCC drops a vector_size that
+// depends on a template parameter.
+template <int size>
+struct SolveRow;
+template <>
+struct SolveRow<2> {
+  typedef double type __attribute__((vector_size(2 * sizeof(double)), aligned(alignof(double)), may_alias));
+};
+template <>
+struct SolveRow<4> {
+  typedef double type __attribute__((vector_size(4 * sizeof(double)), aligned(alignof(double)), may_alias));
+};
+
 // X = A^-1 X for a factor of A = P^T L D L^T P and X of `width` columns, row-major (the
-// components that share A solved together: L is read once for all of them); scratch of X's
-// size. The triangular solves spelled out over L's columns (Eigen's solve takes one column at a
-// time, and applies the inverse permutation in place, which allocates a mask each call).
+// components that share A solved together: L is read once for all of them); scratch of X's rows,
+// padded. The triangular solves spelled out over L's columns (Eigen's solve takes one column at a
+// time, and applies the inverse permutation in place, which allocates a mask each call). A row
+// of the scratch is one small vector (width 3 padded to 4, 1 to 2), so an entry of L costs one
+// vector multiply-add for all the components, each component's arithmetic that of a loop over
+// them (the same bits).
 template <int width>
 void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, double* x,
                        std::vector<double>& scratch) {
+  constexpr int padded = std::max(2, static_cast<int>(std::bit_ceil(static_cast<unsigned>(width))));  // a vector of one is a double
+  using Row = typename SolveRow<padded>::type;
   // L by columns, each holding only its rows below the diagonal (an LDL^T stores no unit diagonal)
   const auto& L = f.matrixL().nestedExpression();
   const Eigen::Index n = L.cols();
@@ -26,30 +47,31 @@ void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>&
   const int* outer = L.outerIndexPtr();
   const int* inner = L.innerIndexPtr();
   const double* value = L.valuePtr();
-  scratch.resize(static_cast<std::size_t>(n * width));
-  double* y = scratch.data();
-  for (Eigen::Index i = 0; i < n; ++i)
-    for (int c = 0; c < width; ++c) y[perm[i] * width + c] = x[i * width + c];
-  for (Eigen::Index j = 0; j < n; ++j)  // L y' = y
-    for (int p = outer[j]; p < outer[j + 1]; ++p)
-      for (int c = 0; c < width; ++c) y[inner[p] * width + c] -= value[p] * y[j * width + c];
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (int c = 0; c < width; ++c) y[j * width + c] /= D[j];
+  scratch.resize(static_cast<std::size_t>(n * padded));
+  Row* y = reinterpret_cast<Row*>(scratch.data());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Row row{};
+    for (int c = 0; c < width; ++c) row[c] = x[i * width + c];
+    y[perm[i]] = row;
+  }
+  for (Eigen::Index j = 0; j < n; ++j) {  // L y' = y (L's rows in column j lie below j: y[j] is final)
+    const Row yj = y[j];
+    for (int p = outer[j]; p < outer[j + 1]; ++p) y[inner[p]] -= value[p] * yj;
+  }
+  for (Eigen::Index j = 0; j < n; ++j) y[j] /= D[j];
   // L^T y'' = y': a dot product per column, in four partial sums (one sum would wait on each
   // add in turn: the solve's critical path).
   constexpr int sums = 4;
   for (Eigen::Index j = n - 1; j >= 0; --j) {
-    double sum[sums][width] = {};
+    Row sum[sums] = {};
     int p = outer[j];
     for (; p + sums <= outer[j + 1]; p += sums)
-      for (int u = 0; u < sums; ++u)
-        for (int c = 0; c < width; ++c) sum[u][c] += value[p + u] * y[inner[p + u] * width + c];
-    for (; p < outer[j + 1]; ++p)
-      for (int c = 0; c < width; ++c) sum[0][c] += value[p] * y[inner[p] * width + c];
-    for (int c = 0; c < width; ++c) y[j * width + c] -= (sum[0][c] + sum[1][c]) + (sum[2][c] + sum[3][c]);
+      for (int u = 0; u < sums; ++u) sum[u] += value[p + u] * y[inner[p + u]];
+    for (; p < outer[j + 1]; ++p) sum[0] += value[p] * y[inner[p]];
+    y[j] -= (sum[0] + sum[1]) + (sum[2] + sum[3]);
   }
   for (Eigen::Index i = 0; i < n; ++i)
-    for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i] * width + c];
+    for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i]][c];
 }
 
 // out = A x for a row-major A and x of `width` columns whose rows lie `stride` apart (a Matrix3,
