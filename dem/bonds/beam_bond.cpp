@@ -60,7 +60,6 @@ inline Lanes inverse_sqrt(Lanes x) {
 #endif
 }
 
-
 // The series of atan(x)/x = 1 - x^2/3 + x^4/5 - x^6/7 in x2 = x^2: below x = 0.05
 // (2.9 degrees, where bonds live) it is exact to 5e-12 relative and costs a tenth of libm's
 // atan2, which otherwise dominates the bond loop (and has no vector form here).
