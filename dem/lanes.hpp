@@ -42,6 +42,8 @@ inline Lanes dot(const LaneVec& a, const LaneVec& b) { return a.x * b.x + a.y * 
 inline LaneVec cross(const LaneVec& a, const LaneVec& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
+inline LaneQuat operator*(const LaneQuat& a, const LaneQuat& b) { return quaternion_product(a, b); }
+inline LaneQuat renormalized(const LaneQuat& q) { return quaternion_renormalized(q); }
 // R(q) a = a + 2w (v x a) + 2 v x (v x a), as common/quat.hpp's rotate: with t = (2 v) x a (2 v
 // exact, shared by the rotations with one q), each component a + w t + v x t as three fused
 // multiply-adds, not a product, a cross product and two sums.

@@ -37,24 +37,15 @@ void drift_eight(Vec3* x, const Vec3* v, const Vec3* omega, Quat* q, double dt) 
   for (std::size_t l = 0; l < lanes; ++l) wq[l] = load_position(omega[l]), std::memcpy(&qq[l], &q[l], sizeof qq[l]);
   const LaneQuat wt = transpose(wq), qt = transpose(qq);
   const LaneVec w{wt.w, wt.v.x, wt.v.y};
-  // exp(phi) of phi = dt omega by quat.hpp's series: (cos(a/2), phi sin(a/2)/a), a = |phi|
+  // exp(phi) q, phi = dt omega, renormalized, as from_rotation_vector below the series' limit
   const LaneVec phi = dt * w;
   const Lanes a2 = dot(phi, phi);
-  constexpr double one_8th = 1.0 / 8.0, one_48th = 1.0 / 48.0, one_80th = 1.0 / 80.0;
-  const Lanes c = 1.0 - a2 * one_8th * (1.0 - a2 * one_48th);
-  const Lanes s = 0.5 - a2 * one_48th * (1.0 - a2 * one_80th);
-  const LaneVec d = phi * s;
-  // (c, d) q as Quat's operator*: (c q.w - d . q.v, c q.v + q.w d + d x q.v), then renormalized
-  const Lanes qw = qt.w, qx = qt.v.x, qy = qt.v.y, qz = qt.v.z;
-  const Lanes rw = c * qw - (d.x * qx + d.y * qy + d.z * qz);
-  const Lanes rx = qx * c + d.x * qw + (d.y * qz - d.z * qy);
-  const Lanes ry = qy * c + d.y * qw + (d.z * qx - d.x * qz);
-  const Lanes rz = qz * c + d.z * qw + (d.x * qy - d.y * qx);
-  const Lanes scale = 1.5 - 0.5 * (rw * rw + (rx * rx + ry * ry + rz * rz));
+  const HalfAngle<Lanes> h = half_angle_series(a2);
+  const LaneQuat r = renormalized(LaneQuat{h.cos_half, phi * h.sin_half_over_angle} * qt);
   const Lanes w2 = dot(w, w);
   for (std::size_t l = 0; l < lanes; ++l) {
     if (!(w2[l] > 0.0)) continue;  // not turning: q stays as it is
-    if (a2[l] < 1e-4) q[l] = {rw[l] * scale[l], {rx[l] * scale[l], ry[l] * scale[l], rz[l] * scale[l]}};
+    if (a2[l] < 1e-4) q[l] = {r.w[l], {r.v.x[l], r.v.y[l], r.v.z[l]}};
     else q[l] = renormalized(from_rotation_vector(omega[l] * dt) * q[l]);
   }
 }
