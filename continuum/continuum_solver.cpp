@@ -13,6 +13,7 @@
 
 #include "common/damped_step.hpp"
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "continuum/petsc_session.hpp"
 
 namespace arlequin::continuum {
@@ -382,39 +383,45 @@ void ContinuumSolver::set_damping(double coefficient) {
   damping_force_.assign(u_.size(), 0.0);  // until the next compute_forces (the state at rest)
 }
 
+// The per-dof loops of the explicit step run on the threads (common/parallel.hpp): each dof's
+// arithmetic is its own, so the bits do not depend on the thread count; the damped kick's work is
+// summed by chunks in a fixed order.
 void ContinuumSolver::compute_forces() {
   internal_force(u_, f_);
-  for (double& v : f_) v = -v;
+  const long n = static_cast<long>(f_.size());
+  for_each_index(n, n > parallel_threshold, [f = f_.data()](long d) { f[d] = -f[d]; });
   add_external_force(f_);
   if (!(damping_ > 0.0)) return;
-  for (size_t d = 0; d < f_.size(); ++d) {
+  for_each_index(n, n > parallel_threshold, [this](long d) {
     damping_force_[d] = is_fixed_[d] ? 0.0 : -damping_ * dof_mass_[d] * v_[d];
     f_[d] += damping_force_[d];
-  }
+  });
 }
 
 void ContinuumSolver::kick(double dt) {
+  const long n = static_cast<long>(v_.size());
   if (!(damping_ > 0.0)) {
-    for (size_t d = 0; d < v_.size(); ++d)
+    for_each_index(n, n > parallel_threshold, [this, dt](long d) {
       if (!is_fixed_[d]) v_[d] += dt * f_[d] / dof_mass_[d];
+    });
     return;
   }
   // A kick changes a dof's kinetic energy by dt f (v + v')/2 exactly; the damping force's share
   // of that is the energy it dissipated (as DemModel::kick).
-  double work = 0.0;
-  for (size_t d = 0; d < v_.size(); ++d) {
-    if (is_fixed_[d]) continue;
+  dissipated_ -= fixed_order_sum(n, parallel_threshold, kick_partial_, [this, dt](long d) {
+    if (is_fixed_[d]) return 0.0;
     const double v = v_[d];
     v_[d] += dt * f_[d] / dof_mass_[d];
-    work -= dt * damping_force_[d] * 0.5 * (v + v_[d]);
-  }
-  dissipated_ += work;
+    return dt * damping_force_[d] * 0.5 * (v + v_[d]);
+  });
 }
 
 void ContinuumSolver::drift(double dt) {
   t_ += dt;
-  for (size_t d = 0; d < u_.size(); ++d)
+  const long n = static_cast<long>(u_.size());
+  for_each_index(n, n > parallel_threshold, [this, dt](long d) {
     if (!is_fixed_[d]) u_[d] += dt * v_[d];
+  });
   for (const Fixed& f : fixed_) {
     const double g = prescribed(f, t_);
     v_[f.dof] = (g - u_[f.dof]) / dt;

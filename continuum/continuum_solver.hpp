@@ -271,6 +271,7 @@ class ContinuumSolver {
   double damping_ = 0.0;         // 1/s
   Field damping_force_;          // N per dof, of the last compute_forces (both half kicks use it)
   double dissipated_ = 0.0;      // J
+  std::vector<double> kick_partial_;  // the damped kick's work, per chunk of dofs (fixed_order_sum)
   // A step's work so far and its scratch: with tractions, u and f_ext at the step's start and f_ext
   // at its end; the prescribed dofs' u and f at the step's start.
   double step_work_ = 0.0;

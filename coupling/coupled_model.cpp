@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "dem/laguerre_cells.hpp"
 
 namespace arlequin::coupling {
@@ -188,16 +189,21 @@ std::string CoupledModel::summary() const {
   return s.str();
 }
 
+// The per-DE and per-node loops of the coupled step run on the threads (common/parallel.hpp):
+// each entry's arithmetic is its own, so the bits do not depend on the thread count.
 void CoupledModel::gather_dem_velocity(Matrix3& v) const {
-  v.resize(ops_.num_particles(), 3);
-  for (int p = 0; p < ops_.num_particles(); ++p) {
+  const long np = ops_.num_particles();
+  v.resize(np, 3);
+  for_each_index(np, np > parallel_threshold, [&](long p) {
     const Vec3& u = dem_.particles.velocity[ops_.particles[p]];
     v.row(p) << u.x, u.y, u.z;
-  }
+  });
 }
 
 void CoupledModel::scatter_dem_velocity(const Matrix3& v) {
-  for (int p = 0; p < ops_.num_particles(); ++p) dem_.particles.velocity[ops_.particles[p]] = {v(p, 0), v(p, 1), v(p, 2)};
+  const long np = ops_.num_particles();
+  for_each_index(np, np > parallel_threshold,
+                 [&](long p) { dem_.particles.velocity[ops_.particles[p]] = {v(p, 0), v(p, 1), v(p, 2)}; });
 }
 
 Eigen::Map<Matrix3> CoupledModel::continuum_velocity() {
@@ -217,9 +223,17 @@ void CoupledModel::step(double dt) {
 
 void CoupledModel::constraint_half_kick(double dt) {
   const double h = 0.5 * dt;
-  for (int p = 0; p < ops_.num_particles(); ++p)
+  const long np = ops_.num_particles();
+  for_each_index(np, np > parallel_threshold, [&](long p) {
     dem_.particles.velocity[ops_.particles[p]] -= Vec3{acc_d_(p, 0), acc_d_(p, 1), acc_d_(p, 2)} * h;
-  continuum_velocity() -= h * acc_c_;
+  });
+  // acc_c_ is 0 but on the nodes the projection corrects
+  const std::vector<int>& nodes = solver_->corrected_nodes();
+  Eigen::Map<Matrix3> vc = continuum_velocity();
+  for_each_index(static_cast<long>(nodes.size()), static_cast<long>(nodes.size()) > parallel_threshold, [&](long k) {
+    const int n = nodes[static_cast<std::size_t>(k)];
+    vc.row(n) -= h * acc_c_.row(n);
+  });
 }
 
 void CoupledModel::advance_models(double dt) {
@@ -262,7 +276,7 @@ void CoupledModel::solve_and_correct(double dt) {
   scatter_dem_velocity(vd_);
   const double h = 0.5 * dt;
   acc_d_ /= h;
-  acc_c_ /= h;
+  for (int n : solver_->corrected_nodes()) acc_c_.row(n) /= h;  // 0 elsewhere (MultiplierSolver::project)
   lambda_ /= h;  // now mu(n+1)
   // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2).
   coupling_work_ -= 0.5 * dt * ((mu_ + lambda_).cwiseProduct(drift_residual_)).sum();

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <type_traits>
 
 #include "common/error.hpp"
 #include "common/parallel.hpp"
@@ -29,49 +30,79 @@ struct SolveRow<4> {
 };
 
 // X = A^-1 X for a factor of A = P^T L D L^T P and X of `width` columns, row-major (the
-// components that share A solved together: L is read once for all of them); scratch of X's rows,
-// padded. The triangular solves spelled out over L's columns (Eigen's solve takes one column at a
-// time, and applies the inverse permutation in place, which allocates a mask each call). A row
-// of the scratch is one small vector (width 3 padded to 4, 1 to 2), so an entry of L costs one
-// vector multiply-add for all the components, each component's arithmetic that of a loop over
-// them (the same bits).
+// components that share A solved together: L is read once for all of them), in three parts:
+// load_permuted puts X into the scratch y = P X, solve_columns runs the triangular solves over
+// one task's columns (MultiplierSolver::ForestFactor: trees of the elimination forest, which
+// read and write only their own rows of y), store_permuted puts y back, X = P^T y. The solves
+// are spelled out over L's columns (Eigen's solve takes one column at a time, and applies the
+// inverse permutation in place, which allocates a mask each call). A row of the scratch is one
+// small vector (width 3 padded to 4, 1 to 2), so an entry of L costs one vector multiply-add for
+// all the components, each component's arithmetic that of a loop over them. A row's updates come
+// from the same columns in the same order whichever tasks run and on which thread: the bits of
+// one serial pass over all the columns.
 template <int width>
-void solve_with_factor(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, double* x,
-                       std::vector<double>& scratch) {
-  constexpr int padded = std::max(2, static_cast<int>(std::bit_ceil(static_cast<unsigned>(width))));  // a vector of one is a double
-  using Row = typename SolveRow<padded>::type;
-  // L by columns, each holding only its rows below the diagonal (an LDL^T stores no unit diagonal)
-  const auto& L = f.matrixL().nestedExpression();
-  const Eigen::Index n = L.cols();
+using RowOf = typename SolveRow<std::max(2, static_cast<int>(std::bit_ceil(static_cast<unsigned>(width))))>::type;
+
+template <int width>
+void load_permuted(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const double* x, std::vector<double>& scratch) {
+  using Row = RowOf<width>;
+  const Eigen::Index n = f.matrixL().nestedExpression().cols();
   const int* perm = f.permutationP().indices().data();
-  const int* outer = L.outerIndexPtr();
-  const int* inner = L.innerIndexPtr();
-  const double* value = L.valuePtr();
-  scratch.resize(static_cast<std::size_t>(n * padded));
+  scratch.resize(static_cast<std::size_t>(n) * sizeof(Row) / sizeof(double));
   Row* y = reinterpret_cast<Row*>(scratch.data());
-  for (Eigen::Index i = 0; i < n; ++i) {
+  for_each_index(n, n > parallel_threshold, [&](long i) {
     Row row{};
     for (int c = 0; c < width; ++c) row[c] = x[i * width + c];
     y[perm[i]] = row;
+  });
+}
+
+template <int width>
+void solve_columns(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, const int* columns,
+                   const int* columns_end, std::vector<double>& scratch) {
+  using Row = RowOf<width>;
+  // L by columns, each holding only its rows below the diagonal (an LDL^T stores no unit diagonal)
+  const auto& L = f.matrixL().nestedExpression();
+  const int* outer = L.outerIndexPtr();
+  const int* inner = L.innerIndexPtr();
+  const double* value = L.valuePtr();
+  Row* y = reinterpret_cast<Row*>(scratch.data());
+  for (const int* j = columns; j != columns_end; ++j) {  // L y' = y (L's rows in column j lie below j: y[j] is final)
+    const Row yj = y[*j];
+    for (int p = outer[*j]; p < outer[*j + 1]; ++p) y[inner[p]] -= value[p] * yj;
   }
-  for (Eigen::Index j = 0; j < n; ++j) {  // L y' = y (L's rows in column j lie below j: y[j] is final)
-    const Row yj = y[j];
-    for (int p = outer[j]; p < outer[j + 1]; ++p) y[inner[p]] -= value[p] * yj;
-  }
-  for (Eigen::Index j = 0; j < n; ++j) y[j] /= D[j];
+  for (const int* j = columns; j != columns_end; ++j) y[*j] /= D[*j];
   // L^T y'' = y': a dot product per column, in four partial sums (one sum would wait on each
   // add in turn: the solve's critical path).
   constexpr int sums = 4;
-  for (Eigen::Index j = n - 1; j >= 0; --j) {
+  for (const int* j = columns_end; j != columns;) {
+    --j;
     Row sum[sums] = {};
-    int p = outer[j];
-    for (; p + sums <= outer[j + 1]; p += sums)
+    int p = outer[*j];
+    for (; p + sums <= outer[*j + 1]; p += sums)
       for (int u = 0; u < sums; ++u) sum[u] += value[p + u] * y[inner[p + u]];
-    for (; p < outer[j + 1]; ++p) sum[0] += value[p] * y[inner[p]];
-    y[j] -= (sum[0] + sum[1]) + (sum[2] + sum[3]);
+    for (; p < outer[*j + 1]; ++p) sum[0] += value[p] * y[inner[p]];
+    y[*j] -= (sum[0] + sum[1]) + (sum[2] + sum[3]);
   }
-  for (Eigen::Index i = 0; i < n; ++i)
+}
+
+template <int width>
+void store_permuted(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const std::vector<double>& scratch, double* x) {
+  using Row = RowOf<width>;
+  const Eigen::Index n = f.matrixL().nestedExpression().cols();
+  const int* perm = f.permutationP().indices().data();
+  const Row* y = reinterpret_cast<const Row*>(scratch.data());
+  for_each_index(n, n > parallel_threshold, [&](long i) {
     for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i]][c];
+  });
+}
+
+// f(std::integral_constant<int, w>) for w = width, 1, 2 or 3: the templates above from a run-time width.
+template <class F>
+void with_width(int width, F&& f) {
+  if (width == 3) f(std::integral_constant<int, 3>{});
+  else if (width == 2) f(std::integral_constant<int, 2>{});
+  else f(std::integral_constant<int, 1>{});
 }
 
 // out = A x for a row-major A and x of `width` columns whose rows lie `stride` apart (a Matrix3,
@@ -153,8 +184,7 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() con
     auto f = std::make_unique<Factor>();
     f->compute(K);
     if (f->info() != Eigen::Success || !(f->vectorD().minCoeff() > 0.0)) return nullptr;
-    a->K_diagonal.push_back(f->vectorD());
-    a->K.push_back(std::move(f));
+    a->K.push_back(forest_of(std::move(f)));
   }
   // The set-up check: A y = r to 1e-10 for y solved from a fixed r (A applied matrix-free,
   // D y + T U H C H U^T y per component).
@@ -184,28 +214,35 @@ std::pair<std::array<int, 3>, int> MultiplierSolver::served_by(int k) const {
 void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const {
   const Eigen::Index rows = rhs.rows(), k = a.U.cols();
   y_.resize(rows, 3);
-  for (Eigen::Index r = 0; r < rows; ++r)  // y = D^-1 rhs, 0 in the free components
+  for_each_index(rows, rows > parallel_threshold, [&](long r) {  // y = D^-1 rhs, 0 in the free components
     for (int c = 0; c < 3; ++c) y_(r, c) = a.tied(r, c) * (a.inv_D[r] * rhs(r, c));
+  });
   w_.resize(k, 3);
-  multiply<3>(a.Ut, y_.data(), 3, w_.data());  // U^T y, then w = K^-1 U^T y system by system
+  multiply<3>(a.Ut, y_.data(), 3, w_.data());  // U^T y, then w = K^-1 U^T y, every system at once
   w_.array() *= a.movable.array();
-  for (int s = 0; s < static_cast<int>(a.K.size()); ++s) {
+  const int systems = static_cast<int>(a.K.size());
+  blocks_.resize(a.K.size());
+  for (int s = 0; s < systems; ++s) {
     const auto [served, width] = served_by(s);
-    block_.resize(static_cast<std::size_t>(k * width));
+    std::vector<double>& block = blocks_[static_cast<std::size_t>(s)];
+    block.resize(static_cast<std::size_t>(k * width));
     for (Eigen::Index j = 0; j < k; ++j)
-      for (int m = 0; m < width; ++m) block_[static_cast<std::size_t>(j * width + m)] = w_(j, served[static_cast<std::size_t>(m)]);
-    if (width == 3) solve_with_factor<3>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
-    else if (width == 2) solve_with_factor<2>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
-    else solve_with_factor<1>(*a.K[s], a.K_diagonal[s], block_.data(), block_scratch_);
+      for (int m = 0; m < width; ++m) block[static_cast<std::size_t>(j * width + m)] = w_(j, served[static_cast<std::size_t>(m)]);
+  }
+  solve_blocks(a.K);
+  for (int s = 0; s < systems; ++s) {
+    const auto [served, width] = served_by(s);
+    const std::vector<double>& block = blocks_[static_cast<std::size_t>(s)];
     for (Eigen::Index j = 0; j < k; ++j)
-      for (int m = 0; m < width; ++m) w_(j, served[static_cast<std::size_t>(m)]) = block_[static_cast<std::size_t>(j * width + m)];
+      for (int m = 0; m < width; ++m) w_(j, served[static_cast<std::size_t>(m)]) = block[static_cast<std::size_t>(j * width + m)];
   }
   lambda.resize(rows, 3);
   multiply<3>(a.U, w_.data(), 3, lambda.data());  // U w
-  for (Eigen::Index r = 0; r < rows; ++r)  // lambda = y - D^-1 U w
+  for_each_index(rows, rows > parallel_threshold, [&](long r) {  // lambda = y - D^-1 U w
     for (int c = 0; c < 3; ++c) lambda(r, c) = a.tied(r, c) * (y_(r, c) - a.inv_D[r] * lambda(r, c));
+  });
   if (dc)  // M_c^-1 G_c^T lambda = w on U's columns (header)
-    for (Eigen::Index j = 0; j < k; ++j) dc->row(a.node[static_cast<std::size_t>(j)]) = w_.row(j);
+    for_each_index(k, k > parallel_threshold, [&](long j) { dc->row(a.node[static_cast<std::size_t>(j)]) = w_.row(j); });
 }
 
 // A depends on the continuum's inverse masses only at the nodes G_c reaches: a node held in one
@@ -226,6 +263,8 @@ int MultiplierSolver::system_of_earlier_component(int c) const {
 MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vector<double>& inv_mass_d,
                                    const std::vector<double>& inv_mass_c, const std::optional<std::string>& petsc)
     : ops_(&ops), GdT_(ops.Gd.transpose()), GcT_(ops.Gc.transpose()) {
+  for (int n = 0; n < GcT_.outerSize(); ++n)
+    if (GcT_.outerIndexPtr()[n + 1] > GcT_.outerIndexPtr()[n]) corrected_nodes_.push_back(n);
   const int np = ops.num_particles(), nn = static_cast<int>(ops.Gc.cols());
   if (static_cast<int>(inv_mass_d.size()) != np || static_cast<int>(inv_mass_c.size()) != 3 * nn)
     throw std::invalid_argument("MultiplierSolver: inverse mass sizes do not match the operators");
@@ -291,8 +330,7 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
       petsc_.push_back(std::make_unique<PetscSpdSolver>(Acol, *petsc));
       continue;
     }
-    diagonals_.push_back(f->vectorD());
-    factors_.push_back(std::move(f));
+    factors_.push_back(forest_of(std::move(f)));
   }
 }
 
@@ -303,12 +341,12 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
   if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda, nullptr);
   lambda.resize(rhs.rows(), 3);
   const Eigen::Index rows = rhs.rows();
-  for (int k = 0; k < systems_; ++k) {
-    const auto [served, width] = served_by(k);
-    if (!petsc_.empty()) {
-      // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
-      // from another component or step would make the multipliers depend on the run's history,
-      // which a restart (docs/restart.md) could not reproduce.
+  if (!petsc_.empty()) {
+    // Each solve starts from zero, whatever -ksp_initial_guess_nonzero says: a guess carried over
+    // from another component or step would make the multipliers depend on the run's history,
+    // which a restart (docs/restart.md) could not reproduce.
+    for (int k = 0; k < systems_; ++k) {
+      const auto [served, width] = served_by(k);
       for (int s = 0; s < width; ++s) {
         const int c = served[static_cast<std::size_t>(s)];
         column_ = rhs.col(c).cwiseProduct(scales_[k]);
@@ -316,26 +354,107 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
         petsc_[k]->solve(column_.data(), solution_.data());
         lambda.col(c) = Eigen::Map<const Eigen::VectorXd>(solution_.data(), rows).cwiseProduct(scales_[k]);
       }
-      continue;
     }
-    block_.resize(static_cast<std::size_t>(rows * width));
+    return;
+  }
+  blocks_.resize(static_cast<std::size_t>(systems_));
+  for (int k = 0; k < systems_; ++k) {
+    const auto [served, width] = served_by(k);
+    std::vector<double>& block = blocks_[static_cast<std::size_t>(k)];
+    block.resize(static_cast<std::size_t>(rows * width));
     const double* scale = scales_[k].data();
     for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s) block_[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * scale[r];
-    if (width == 3) solve_with_factor<3>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
-    else if (width == 2) solve_with_factor<2>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
-    else solve_with_factor<1>(*factors_[k], diagonals_[k], block_.data(), block_scratch_);
+      for (int s = 0; s < width; ++s) block[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * scale[r];
+  }
+  solve_blocks(factors_);
+  for (int k = 0; k < systems_; ++k) {
+    const auto [served, width] = served_by(k);
+    const std::vector<double>& block = blocks_[static_cast<std::size_t>(k)];
+    const double* scale = scales_[k].data();
     for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s) lambda(r, served[static_cast<std::size_t>(s)]) = block_[static_cast<std::size_t>(r * width + s)] * scale[r];
+      for (int s = 0; s < width; ++s) lambda(r, served[static_cast<std::size_t>(s)]) = block[static_cast<std::size_t>(r * width + s)] * scale[r];
+  }
+}
+
+MultiplierSolver::ForestFactor MultiplierSolver::forest_of(std::unique_ptr<Factor> factor) {
+  ForestFactor f;
+  const auto& L = factor->matrixL().nestedExpression();
+  const int n = static_cast<int>(L.cols());
+  const int* outer = L.outerIndexPtr();
+  const int* inner = L.innerIndexPtr();
+  // Each column's tree, from the last column down: a parent's index is larger than its child's.
+  std::vector<int> tree(static_cast<std::size_t>(n)), start(1, 0);
+  for (int j = n - 1; j >= 0; --j) {
+    int parent = n;
+    for (int p = outer[j]; p < outer[j + 1]; ++p) parent = std::min(parent, inner[p]);
+    if (parent == n) start.push_back(0);  // a root: a new tree
+    tree[static_cast<std::size_t>(j)] = parent == n ? static_cast<int>(start.size()) - 2 : tree[static_cast<std::size_t>(parent)];
+  }
+  // The columns tree by tree, each tree's in increasing order (a counting sort by tree).
+  for (int t : tree) ++start[static_cast<std::size_t>(t) + 1];
+  for (std::size_t t = 1; t < start.size(); ++t) start[t] += start[t - 1];
+  f.columns.resize(static_cast<std::size_t>(n));
+  std::vector<int> next(start.begin(), start.end() - 1);
+  for (int j = 0; j < n; ++j) f.columns[static_cast<std::size_t>(next[static_cast<std::size_t>(tree[static_cast<std::size_t>(j)])]++)] = j;
+  // Whole trees, in order, into tasks of at least task_columns columns (the last may have fewer).
+  f.task_start.push_back(0);
+  for (std::size_t t = 1; t < start.size(); ++t)
+    if (start[t] - f.task_start.back() >= task_columns || t + 1 == start.size()) f.task_start.push_back(start[t]);
+  f.D = factor->vectorD();
+  f.factor = std::move(factor);
+  return f;
+}
+
+void MultiplierSolver::solve_blocks(const std::vector<ForestFactor>& factors) const {
+  const auto systems = static_cast<int>(factors.size());
+  block_scratch_.resize(factors.size());
+  std::array<long, 4> first_task{};  // system s's tasks are [first_task[s], first_task[s + 1]) of all
+  long nonzeros = 0;
+  for (int s = 0; s < systems; ++s) {
+    const auto z = static_cast<std::size_t>(s);
+    const Factor& factor = *factors[z].factor;
+    with_width(served_by(s).second, [&](auto width) {
+      load_permuted<decltype(width)::value>(factor, blocks_[z].data(), block_scratch_[z]);
+    });
+    first_task[z + 1] = first_task[z] + static_cast<long>(factors[z].task_start.size()) - 1;
+    nonzeros += factor.matrixL().nestedExpression().nonZeros();
+  }
+  const long tasks = first_task[static_cast<std::size_t>(systems)];
+  // The tasks are independent and each does the same arithmetic on any thread: the same bits on
+  // any thread count. Sizes differ (a tree of a few columns, one of thousands): dynamic.
+  run_threaded_if(tasks > 1 && nonzeros > parallel_threshold, [&] {
+#pragma omp for schedule(dynamic, 1)
+    for (long i = 0; i < tasks; ++i) {
+      std::size_t s = 0;
+      while (i >= first_task[s + 1]) ++s;
+      const ForestFactor& f = factors[s];
+      const auto t = static_cast<std::size_t>(i - first_task[s]);
+      const int* columns = f.columns.data();
+      with_width(served_by(static_cast<int>(s)).second, [&](auto width) {
+        solve_columns<decltype(width)::value>(*f.factor, f.D, columns + f.task_start[t], columns + f.task_start[t + 1],
+                                              block_scratch_[s]);
+      });
+    }
+  });
+  for (int s = 0; s < systems; ++s) {
+    const auto z = static_cast<std::size_t>(s);
+    with_width(served_by(s).second, [&](auto width) {
+      store_permuted<decltype(width)::value>(*factors[z].factor, block_scratch_[z], blocks_[z].data());
+    });
   }
 }
 
 std::string MultiplierSolver::backend() const {
   if (low_rank_) {
     long largest = 0;
-    for (const auto& K : low_rank_->K) largest = std::max<long>(largest, K->matrixL().nestedExpression().nonZeros());
+    std::size_t parts = 0;
+    for (const auto& K : low_rank_->K) {
+      largest = std::max<long>(largest, K.factor->matrixL().nestedExpression().nonZeros());
+      parts += K.task_start.size() - 1;
+    }
     return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_->U.cols()) + " continuum nodes a system (" +
-           std::to_string(largest) + " non-zeros in the largest factor)";
+           std::to_string(largest) + " non-zeros in the largest factor; the systems' solves in " + std::to_string(parts) +
+           " independent parts)";
   }
   return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description();
 }
@@ -349,20 +468,25 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
-  dc.resize(GcT_.rows(), 3);
-  if (low_rank_) {  // the solve leaves M_c^-1 G_c^T lambda on U's columns, 0 on the other nodes
-    dc.setZero();
+  if (dc.rows() != GcT_.rows()) dc.setZero(GcT_.rows(), 3);
+  if (low_rank_) {  // the solve leaves M_c^-1 G_c^T lambda on U's columns; the other corrected nodes are held: 0
     solve_low_rank(*low_rank_, rhs_, lambda, &dc);
   } else {
     solve(rhs_, lambda);
     multiply<3>(GcT_, lambda.data(), 3, dc.data());
     dc.array() *= inv_c_.array();
   }
-  dd.resize(GdT_.rows(), 3);
+  const long rows = GdT_.rows(), nodes = static_cast<long>(corrected_nodes_.size());
+  dd.resize(rows, 3);
   multiply<3>(GdT_, lambda.data(), 3, dd.data());
-  dd.array() *= inv_d_.array();
-  vd -= dd;
-  vc -= dc;
+  for_each_index(rows, rows > parallel_threshold, [&](long r) {
+    dd.row(r).array() *= inv_d_.row(r).array();
+    vd.row(r) -= dd.row(r);
+  });
+  for_each_index(nodes, nodes > parallel_threshold, [&](long k) {
+    const int n = corrected_nodes_[static_cast<std::size_t>(k)];
+    vc.row(n) -= dc.row(n);
+  });
 }
 
 }  // namespace arlequin::coupling

@@ -17,7 +17,9 @@
 //    The corrections (M^-1 G^T lambda) are returned in dd, dc.
 //  - No allocation per call once the outputs have their sizes (rows x 3, DEs x 3, nodes x 3):
 //    the explicit step calls these every step; scratch lives in the solver (one solver per
-//    coupled model, not shared between threads).
+//    coupled model, not shared between threads). A call runs its loops and the independent
+//    parts of its triangular solves (ForestFactor) on the OpenMP threads, with the same bits
+//    on any thread count; not to be called inside a parallel region.
 //  - Partial ties (CouplingOperators::tied): a row's free components are left out of that
 //    component's system (an empty row of A, a zero row of U) and of the residual, so their
 //    multipliers are 0 and those velocities are not corrected. Components with the same masses
@@ -74,8 +76,12 @@ class MultiplierSolver {
   void solve(const Matrix3& rhs, Matrix3& lambda) const;
   // out = G_d vd + G_c vc (rows x 3), 0 in the components a row leaves free.
   void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
-  // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda.
+  // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda. dc is
+  // written on corrected_nodes() only, and set to 0 when it is resized: a caller that keeps it
+  // between calls (and changes it only there) reads the whole correction in it.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
+  // The continuum nodes a projection can correct (those G_c reaches), in increasing order.
+  const std::vector<int>& corrected_nodes() const { return corrected_nodes_; }
 
   // Distinct systems (one per distinct column of ties and reached inverse masses; the others reuse one).
   int systems() const { return systems_; }
@@ -88,6 +94,19 @@ class MultiplierSolver {
 
  private:
   using Factor = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>;
+  // One system's factor P^T L D L^T P and the independent parts of its solve: the trees of L's
+  // elimination forest (a column's parent is its first row below the diagonal, and every entry of
+  // a column lies in the column's own tree), so that a tree's triangular solves read and write only
+  // its own rows. Trees are grouped, in order, into tasks of at least `task_columns` columns.
+  struct ForestFactor {
+    std::unique_ptr<Factor> factor;
+    Eigen::VectorXd D;
+    std::vector<int> columns;     // L's columns tree by tree, each tree's in increasing order
+    std::vector<int> task_start;  // task t: columns[task_start[t] .. task_start[t + 1])
+  };
+  static constexpr int task_columns = 256;
+  // The forest of a computed factor.
+  static ForestFactor forest_of(std::unique_ptr<Factor> factor);
   // The Woodbury form of one component's A (above).
   using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct LowRank {
@@ -96,8 +115,7 @@ class MultiplierSolver {
     RowMajorMatrix U, Ut;             // rows x the nodes G_c reaches that can move (all components'), its transpose
     std::vector<int> node;            // the continuum node of each of U's columns
     Matrix3 movable;                  // per column and component: 1 where the node can move, 0 where held
-    std::vector<std::unique_ptr<Factor>> K;  // per system, over all of U's columns
-    std::vector<Eigen::VectorXd> K_diagonal;
+    std::vector<ForestFactor> K;      // per system, over all of U's columns
   };
   // The low-rank form of A, or nullptr when it does not apply or its set-up residual check fails.
   std::unique_ptr<LowRank> low_rank_form() const;
@@ -106,6 +124,9 @@ class MultiplierSolver {
   // lambda = A^-1 rhs, every system at once: the products with U and U^T read U once for the
   // three components; with `dc`, dc = M_c^-1 G_c^T lambda on U's columns (the rest untouched).
   void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
+  // blocks_[s] = A_s^-1 blocks_[s] for every system s (blocks_[s] row-major, one column per
+  // component the system serves), A_s = factors[s]: the tasks of all the systems on the threads.
+  void solve_blocks(const std::vector<ForestFactor>& factors) const;
   // The components system k serves (the first `width` entries) and their number.
   std::pair<std::array<int, 3>, int> served_by(int k) const;
   // The system of an earlier component with the same ties and the same continuum inverse masses
@@ -114,18 +135,19 @@ class MultiplierSolver {
 
   const CouplingOperators* ops_;
   RowMajorMatrix GdT_, GcT_;                   // the transposes, for row-wise products
+  std::vector<int> corrected_nodes_;           // GcT_'s rows with an entry
   std::unique_ptr<LowRank> low_rank_;          // the low-rank form, or null
   Matrix3 inv_d_, inv_c_;                      // inverse masses, per row and component
-  std::vector<std::unique_ptr<Factor>> factors_;  // our LDL^T, or
+  std::vector<ForestFactor> factors_;          // our LDL^T, or
   std::vector<std::unique_ptr<PetscSpdSolver>> petsc_;  // PETSc's solve
-  std::vector<Eigen::VectorXd> diagonals_;     // D of each factor
   std::vector<Eigen::VectorXd> scales_;        // Jacobi scaling diag(A)^-1/2 of each factor
   std::array<int, 3> factor_of_{0, 0, 0};      // component -> system
   int systems_ = 0;
   long nonzeros_ = 0;
   mutable Matrix3 rhs_;                        // scratch: the residual to project
   mutable Eigen::VectorXd column_;              // scratch: one component (PETSc)
-  mutable std::vector<double> block_, block_scratch_, solution_;  // scratch: a system's components
+  mutable std::vector<double> solution_;       // scratch: a component (PETSc)
+  mutable std::vector<std::vector<double>> blocks_, block_scratch_;  // scratch: each system's components
   mutable Matrix3 y_, w_;                      // scratch: the low-rank form's D^-1 rhs and K^-1 U^T y
 };
 

@@ -6,6 +6,7 @@
 
 #include "common/error.hpp"
 #include "coupling/multiplier_solver.hpp"
+#include "support/omp_threads.hpp"
 
 using namespace arlequin;
 using namespace arlequin::coupling;
@@ -156,6 +157,59 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   woodbury.residual(vd_w, vc_w, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
   EXPECT_EQ(vc_w(2, 1), vc(2, 1));                      // the held dof
+}
+
+// Two bodies coupled apart (the DCB's two arms): K falls into two blocks, its factor's
+// elimination forest into two trees of 400 columns, and the Woodbury form solves them as two
+// independent parts, on the threads. The multipliers are the general factor's to round-off, G v
+// = 0 after the projection, and the bits are the same on 1 and 2 threads.
+TEST(CouplingMultiplierSolver, TwoBodiesAreSolvedInTwoIndependentParts) {
+  const int bodies = 2, nodes = 400, des = 900, np = bodies * des, nn = bodies * nodes;
+  CouplingOperators fine;
+  fine.settings.mediator = Mediator::fine;
+  fine.N.resize(np, nn);
+  fine.Gd.resize(np, np);
+  fine.Gc.resize(np, nn);
+  std::vector<double> md(np), mc(3 * nn);
+  for (int p = 0; p < np; ++p) {
+    fine.particles.push_back(static_cast<std::uint32_t>(p));
+    const double w = 1e-9 * (1.0 + 0.5 * std::sin(p));
+    const double a = 0.2 + 0.1 * std::cos(3.0 * p), b = 0.3;
+    const int first = (p / des) * nodes, k = (p % des) * 7 % nodes;  // a chain through the body's nodes
+    const int at[3] = {first + k, first + (k + 1) % nodes, first + (k + 2) % nodes};
+    const double N[3] = {a, b, 1.0 - a - b};
+    fine.Gd.insert(p, p) = w;
+    for (int q = 0; q < 3; ++q) {
+      fine.N.insert(p, at[q]) = N[q];
+      fine.Gc.insert(p, at[q]) = -w * N[q];
+    }
+    md[p] = 1.0 / (1e-7 * (1.0 + 0.3 * std::cos(p)));
+  }
+  for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * std::sin(d / 3)));
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;  // the general factor (see above)
+  const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
+  EXPECT_NE(woodbury.backend().find("in 2 independent parts"), std::string::npos) << woodbury.backend();
+
+  Matrix3 vd(np, 3), vc(nn, 3);
+  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.0003 * p;
+  for (int i = 0; i < nn; ++i) vc.row(i) << 0.01 * i, -0.02 * i, std::sin(i);
+  Matrix3 lambda[2], vd_w[2], vc_w[2], dd, dc, lambda_f, residual;
+  for (int threads : {1, 2}) {
+#ifdef _OPENMP
+    const test::OmpThreads scope(threads);
+#endif
+    vd_w[threads - 1] = vd, vc_w[threads - 1] = vc;
+    woodbury.project(vd_w[threads - 1], vc_w[threads - 1], dd, dc, lambda[threads - 1]);
+  }
+  EXPECT_EQ(lambda[0], lambda[1]);
+  EXPECT_EQ(vd_w[0], vd_w[1]);
+  EXPECT_EQ(vc_w[0], vc_w[1]);
+  Matrix3 vd_f = vd, vc_f = vc;
+  factor.project(vd_f, vc_f, dd, dc, lambda_f);
+  EXPECT_LT((lambda[0] - lambda_f).norm(), 1e-10 * lambda_f.norm());
+  woodbury.residual(vd_w[0], vc_w[0], residual);
+  EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
 }
 
 // A held dof at a node no row reaches (a load strip far from the overlap) does not split the
