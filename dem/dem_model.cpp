@@ -117,6 +117,17 @@ void DemModel::finalize() {
     damping_torque_.assign(particles.size(), Vec3{});
   }
   for (auto& set : bond_sets_) set->finalize(particles.size());
+  set_pointers_.clear();
+  pass_sets_.assign(bond_sets_.size(), 1);
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+    set_pointers_.push_back(bond_sets_[s].get());
+    if (s > 0 && bond_sets_[s]->gathers() && bond_sets_[s - 1]->gathers()) {
+      std::size_t first = s - 1;
+      while (pass_sets_[first] == 0) --first;
+      ++pass_sets_[first];
+      pass_sets_[s] = 0;
+    }
+  }
   if (neighbours_) {
     neighbours_->set_exclusions(intact_bonded_pairs());
     neighbours_->build(particles);
@@ -181,10 +192,16 @@ void DemModel::set_profile(StepProfile* profile) {
   phase_.drift = profile->phase("drift and clear forces");
   phase_.boundary = profile->phase("boundary conditions");
   if (neighbours_) phase_.neighbours = profile->phase("neighbour list");
-  phase_.bonds.clear();
-  for (const auto& set : bond_sets_) {
-    const std::string pass = set->colours() > 0 ? std::to_string(set->colours()) + " colours" : "gather";
-    phase_.bonds.push_back(profile->phase("bonds " + set->name + " (" + std::string(set->law()) + ", " + pass + ")"));
+  if (pass_sets_.size() != bond_sets_.size()) throw std::logic_error("DemModel: set_profile before finalize()");
+  phase_.bonds.assign(bond_sets_.size(), 0);
+  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+    if (pass_sets_[s] == 0) continue;  // in an earlier set's pass
+    const BondSet& set = *bond_sets_[s];
+    std::string names = set.name;
+    for (std::size_t k = 1; k < pass_sets_[s]; ++k) names += ", " + bond_sets_[s + k]->name;
+    const std::string pass = set.colours() > 0 ? std::to_string(set.colours()) + " colours"
+                             : pass_sets_[s] > 1 ? "gather, one pass" : "gather";
+    phase_.bonds[s] = profile->phase("bonds " + names + " (" + std::string(set.law()) + ", " + pass + ")");
   }
   if (contact_) phase_.contacts = profile->phase("contacts");
   if (failure_on_) phase_.failure = profile->phase("failure scan and breaks");
@@ -340,9 +357,10 @@ void DemModel::update_neighbours() {
 
 double DemModel::compute_forces(const ForceScan& scan, bool cleared) {
   if (!cleared) particles.clear_forces();
-  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+  for (std::size_t s = 0; s < bond_sets_.size(); s += pass_sets_[s]) {
     const PhaseTimer timer(profile_, profile_ ? phase_.bonds[s] : 0, runs_threaded(bond_sets_[s]->runs_on_threads()));
-    bond_sets_[s]->accumulate_forces(particles, scan);
+    if (pass_sets_[s] > 1) accumulate_gathered_forces({&set_pointers_[s], pass_sets_[s]}, particles, scan);
+    else bond_sets_[s]->accumulate_forces(particles, scan);
   }
   if (!contact_) return 0.0;
   const PhaseTimer timer(profile_, phase_.contacts, false);

@@ -209,6 +209,11 @@ class DemModel {
   std::vector<std::string> group_names_;
   std::vector<std::vector<std::uint32_t>> group_members_;  // per group, increasing DE indices
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
+  // The force passes of the bond sets (finalize()): consecutive gather sets share one
+  // (accumulate_gathered_forces); pass_sets_[s] the number of sets in the pass that starts at
+  // set s, 0 for a set in an earlier set's pass. set_pointers_: bond_sets_'s pointers, for spans.
+  std::vector<std::size_t> pass_sets_;
+  std::vector<const BondSet*> set_pointers_;
   std::unique_ptr<ContactLaw> contact_;
   std::optional<NeighbourList> neighbours_;
   ContactPass deepest_contact_;  // of the last force pass
@@ -246,7 +251,8 @@ class DemModel {
   double damping_ = 0.0;
   Vec3 gravity_{};  // m/s^2
   std::vector<Vec3> damping_force_, damping_torque_;  // this step's, kept for both half kicks
-  // The step's phases in profile_ (set_profile), one per bond set in bonds.
+  // The step's phases in profile_ (set_profile), one per force pass of the bond sets in bonds
+  // (at its first set's index).
   StepProfile* profile_ = nullptr;
   struct ProfilePhases {
     int kick, drift, boundary, neighbours, contacts, failure, reactions, loads, finite;

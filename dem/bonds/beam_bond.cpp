@@ -256,75 +256,81 @@ void BeamBondSet::finalize(std::size_t n_particles) {
 }
 
 void BeamBondSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
-  const Records r = records(scan);
-  const long bonds = static_cast<long>(size());
   if (end_offsets_.empty()) throw std::logic_error("BeamBondSet: a force pass before finalize()");
-  run_threaded_if(colouring_.threaded, [&] {
-    // A thread takes the DEs every per-DE loop gives it (thread_share), the bonds whose first DE
-    // is one of them (the boundaries rounded down to whole blocks) and, in the sums, those DEs.
-    const long n_particles = static_cast<long>(p.size());
-    const IndexRange des = thread_share(n_particles);
-    // Where DE i's entries begin in a list sorted by DE (first_, bonded_).
-    const auto entries_from = [](const std::vector<std::uint32_t>& by_de, long i) {
-      return static_cast<long>(std::lower_bound(by_de.begin(), by_de.end(), static_cast<std::uint32_t>(i)) - by_de.begin());
-    };
-    const long bond_begin = entries_from(first_, des.begin) / long(block) * long(block);
-    const long bond_end = des.end == n_particles ? bonds : entries_from(first_, des.end) / long(block) * long(block);
-    // Every bond's actions (and its failure measure or energy), a block at a time, stored whole.
-    for (long first = bond_begin; first < bond_end; first += long(block)) {
-      ActionsBlock a;
-      const std::size_t count = std::min<std::size_t>(block, std::size_t(bonds - first));
-      actions(std::size_t(first), count, p, a, r.criterion);
-      const double* from[9] = {a.force_on_j[0],  a.force_on_j[1],  a.force_on_j[2],  a.torque_on_i[0], a.torque_on_i[1],
-                               a.torque_on_i[2], a.torque_on_j[0], a.torque_on_j[1], a.torque_on_j[2]};
-      for (int c = 0; c < 9; ++c) std::memcpy(bond_actions_[c].data() + first, from[c], sizeof(ActionsBlock::Lane));
-      if (r.criterion) {  // failure_measure, lane by lane; the lanes at the strength one by one (rare)
-        Lanes axial_stress, bending_stress;
-        std::memcpy(&axial_stress, a.axial_stress, sizeof axial_stress);
-        std::memcpy(&bending_stress, a.bending_stress, sizeof bending_stress);
-        const Lanes measure = axial_stress + bending_stress;
-        std::memcpy(measure_.data() + first, &measure, count * sizeof(double));
-        if (!every_lane(measure < strength()))
-          for (std::size_t l = 0; l < count; ++l) note_measure(first + l, measure[l]);
-      }
-      if (r.energy)
-        for (std::size_t l = 0; l < count; ++l) energy_record_[first + l] = energy_of(first + l, a[l]);
+  const BondSet* self = this;
+  accumulate_gathered_forces({&self, 1}, p, scan);
+}
+
+namespace {
+// Where DE i's entries begin in a list sorted by DE (first_, bonded_).
+long entries_from(const std::vector<std::uint32_t>& by_de, long i) {
+  return static_cast<long>(std::lower_bound(by_de.begin(), by_de.end(), static_cast<std::uint32_t>(i)) - by_de.begin());
+}
+}  // namespace
+
+void BeamBondSet::evaluate_share(const ParticleSet& p, const ForceScan& scan, IndexRange des) const {
+  const Records r = records(scan);
+  const long bonds = static_cast<long>(size()), n_particles = static_cast<long>(p.size());
+  // The bonds whose first DE is one of `des`, the boundaries rounded down to whole blocks.
+  const long bond_begin = entries_from(first_, des.begin) / long(block) * long(block);
+  const long bond_end = des.end == n_particles ? bonds : entries_from(first_, des.end) / long(block) * long(block);
+  // Every bond's actions (and its failure measure or energy), a block at a time, stored whole.
+  for (long first = bond_begin; first < bond_end; first += long(block)) {
+    ActionsBlock a;
+    const std::size_t count = std::min<std::size_t>(block, std::size_t(bonds - first));
+    actions(std::size_t(first), count, p, a, r.criterion);
+    const double* from[9] = {a.force_on_j[0],  a.force_on_j[1],  a.force_on_j[2],  a.torque_on_i[0], a.torque_on_i[1],
+                             a.torque_on_i[2], a.torque_on_j[0], a.torque_on_j[1], a.torque_on_j[2]};
+    for (int c = 0; c < 9; ++c) std::memcpy(bond_actions_[c].data() + first, from[c], sizeof(ActionsBlock::Lane));
+    if (r.criterion) {  // failure_measure, lane by lane; the lanes at the strength one by one (rare)
+      Lanes axial_stress, bending_stress;
+      std::memcpy(&axial_stress, a.axial_stress, sizeof axial_stress);
+      std::memcpy(&bending_stress, a.bending_stress, sizeof bending_stress);
+      const Lanes measure = axial_stress + bending_stress;
+      std::memcpy(measure_.data() + first, &measure, count * sizeof(double));
+      if (!every_lane(measure < strength()))
+        for (std::size_t l = 0; l < count; ++l) note_measure(first + l, measure[l]);
     }
-#pragma omp barrier
-    // Every bonded DE adds its bonds' actions in bond order (-f on a first DE, +f on a second).
-    // Raw pointers: nothing in the loop can move the arrays, and the compiler keeps them in
-    // registers.
-    const double *fx = bond_actions_[0].data(), *fy = bond_actions_[1].data(), *fz = bond_actions_[2].data();
-    const double *tix = bond_actions_[3].data(), *tiy = bond_actions_[4].data(), *tiz = bond_actions_[5].data();
-    const double *tjx = bond_actions_[6].data(), *tjy = bond_actions_[7].data(), *tjz = bond_actions_[8].data();
-    const std::uint32_t *bonded = bonded_.data(), *offsets = end_offsets_.data(), *ends = end_bonds_.data();
-    Vec3 *force = p.force.data(), *torque = p.torque.data();
-    const long k_begin = entries_from(bonded_, des.begin), k_end = entries_from(bonded_, des.end);
-    for (long k = k_begin; k < k_end; ++k) {
-      Vec3 f{}, t{};
-      for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
-        const std::uint32_t b = ends[e] >> 1;
-        if (ends[e] & 1u) {
-          f += Vec3{fx[b], fy[b], fz[b]};
-          t += Vec3{tjx[b], tjy[b], tjz[b]};
-        } else {
-          f -= Vec3{fx[b], fy[b], fz[b]};
-          t += Vec3{tix[b], tiy[b], tiz[b]};
-        }
+    if (r.energy)
+      for (std::size_t l = 0; l < count; ++l) energy_record_[first + l] = energy_of(first + l, a[l]);
+  }
+}
+
+void BeamBondSet::add_share(ParticleSet& p, const ForceScan& scan, IndexRange des) const {
+  const Records r = records(scan);
+  // Every bonded DE of `des` adds its bonds' actions in bond order (-f on a first DE, +f on a
+  // second). Raw pointers: nothing in the loop can move the arrays, and the compiler keeps them
+  // in registers.
+  const double *fx = bond_actions_[0].data(), *fy = bond_actions_[1].data(), *fz = bond_actions_[2].data();
+  const double *tix = bond_actions_[3].data(), *tiy = bond_actions_[4].data(), *tiz = bond_actions_[5].data();
+  const double *tjx = bond_actions_[6].data(), *tjy = bond_actions_[7].data(), *tjz = bond_actions_[8].data();
+  const std::uint32_t *bonded = bonded_.data(), *offsets = end_offsets_.data(), *ends = end_bonds_.data();
+  Vec3 *force = p.force.data(), *torque = p.torque.data();
+  const long k_begin = entries_from(bonded_, des.begin), k_end = entries_from(bonded_, des.end);
+  for (long k = k_begin; k < k_end; ++k) {
+    Vec3 f{}, t{};
+    for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
+      const std::uint32_t b = ends[e] >> 1;
+      if (ends[e] & 1u) {
+        f += Vec3{fx[b], fy[b], fz[b]};
+        t += Vec3{tjx[b], tjy[b], tjz[b]};
+      } else {
+        f -= Vec3{fx[b], fy[b], fz[b]};
+        t += Vec3{tix[b], tiy[b], tiz[b]};
       }
-      force[bonded[k]] += f;
-      torque[bonded[k]] += t;
     }
-    if (!r.virial) return;
-    // Recording the virial (RDEF): each DE's intact bonds' terms, in bond order, as accumulate_virial.
-    for (long k = k_begin; k < k_end; ++k)
-      for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
-        const std::uint32_t b = ends[e] >> 1;
-        if (!broken_[b])
-          add_bond_end_virial(p, first_[b], second_[b], -Vec3{fx[b], fy[b], fz[b]}, scan.branch, static_cast<int>(ends[e] & 1u),
-                              scan.virial[bonded[k]]);
-      }
-  });
+    force[bonded[k]] += f;
+    torque[bonded[k]] += t;
+  }
+  if (!r.virial) return;
+  // Recording the virial (RDEF): each DE's intact bonds' terms, in bond order, as accumulate_virial.
+  for (long k = k_begin; k < k_end; ++k)
+    for (std::uint32_t e = offsets[k]; e < offsets[k + 1]; ++e) {
+      const std::uint32_t b = ends[e] >> 1;
+      if (!broken_[b])
+        add_bond_end_virial(p, first_[b], second_[b], -Vec3{fx[b], fy[b], fz[b]}, scan.branch, static_cast<int>(ends[e] & 1u),
+                            scan.virial[bonded[k]]);
+    }
 }
 
 double BeamBondSet::energy_of(std::size_t b, const Actions& a) const {

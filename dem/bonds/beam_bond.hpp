@@ -61,6 +61,9 @@ class BeamBondSet final : public BondKernelSet<BeamBondSet> {
   // colour, and sums that do not depend on the thread count. It records what BondKernelSet's
   // per-bond pass records (the virial per DE, in bond order, as accumulate_virial).
   void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
+  bool gathers() const override { return true; }
+  void evaluate_share(const ParticleSet& p, const ForceScan& scan, IndexRange des) const override;
+  void add_share(ParticleSet& p, const ForceScan& scan, IndexRange des) const override;
 
   // The generalised forces of bond b in the current configuration (for tests, sensors and
   // failure criteria): forces and torques exerted by the bond on its two DEs.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <numeric>
+#include <stdexcept>
 
 namespace arlequin::dem {
 
@@ -55,6 +56,19 @@ std::vector<std::uint32_t> BondSet::order_pairs_by_first(std::size_t n_particles
   colouring_.offsets.clear();
   colouring_.threaded = BondColouring::worth_threads(size(), 1, n_particles);
   return order;
+}
+
+void BondSet::not_a_gather_pass() { throw std::logic_error("BondSet: a gather pass's half called on a set that does not gather"); }
+
+void accumulate_gathered_forces(std::span<const BondSet* const> sets, ParticleSet& p, const ForceScan& scan) {
+  std::size_t bonds = 0;
+  for (const BondSet* set : sets) bonds += set->size();
+  run_threaded_if(BondColouring::worth_threads(bonds, 1, p.size()), [&] {
+    const IndexRange des = thread_share(static_cast<long>(p.size()));
+    for (const BondSet* set : sets) set->evaluate_share(p, scan, des);
+#pragma omp barrier
+    for (const BondSet* set : sets) set->add_share(p, scan, des);
+  });
 }
 
 void add_bond_end_virial(const ParticleSet& p, std::uint32_t i, std::uint32_t j, const Vec3& f_i, VirialBranch branch,

@@ -111,6 +111,13 @@ class BondSet {
   virtual void add(std::uint32_t i, std::uint32_t j, const ParticleSet& p) = 0;
   virtual void finalize(std::size_t n_particles) = 0;
   virtual void accumulate_forces(ParticleSet& p, const ForceScan& scan) const = 0;
+  // A gather pass (BeamBondSet) is two halves with one barrier between them, each thread on the
+  // DEs `des` it owns (thread_share): the actions of the bonds whose first DE is one of them,
+  // computed and stored; then those DEs' sums of their bonds' actions. Consecutive gather sets
+  // run as one pass (accumulate_gathered_forces). The other laws' passes are not split.
+  virtual bool gathers() const { return false; }
+  virtual void evaluate_share(const ParticleSet&, const ForceScan&, IndexRange) const { not_a_gather_pass(); }
+  virtual void add_share(ParticleSet&, const ForceScan&, IndexRange) const { not_a_gather_pass(); }
   // Elastic energy stored in the batch in configuration p, J (leaves the record alone).
   virtual double energy(const ParticleSet& p) const = 0;
   // Each bond's elastic energy in configuration p into the record that a force pass with
@@ -205,6 +212,7 @@ class BondSet {
     apply_order(energy_record_, order);
   }
   virtual void zero_stiffness(std::size_t b) = 0;
+  [[noreturn]] static void not_a_gather_pass();
   // What the law's bonds remember beyond broken or intact (a cohesive link's damage): none by
   // default.
   virtual void save_law_state(StateArchive&, const std::string& /*prefix*/) const {}
@@ -218,6 +226,14 @@ class BondSet {
   mutable std::vector<double> energy_record_;
   mutable std::vector<double> sum_partial_;
 };
+
+// The force passes of the gather sets `sets` (BondSet::gathers) as one, in one team of threads
+// with one barrier: each thread evaluates every set's bonds at the DEs it owns, then adds every
+// set's actions to those DEs, set after set in the order of `sets`, so that each DE's sums are
+// those of the sets' passes one after the other (the same bits). A set whose bonds lie in a
+// part of the scene (one material of several) has them all at the DEs of a few threads: a pass
+// of its own would leave the other threads waiting at its barrier.
+void accumulate_gathered_forces(std::span<const BondSet* const> sets, ParticleSet& p, const ForceScan& scan);
 
 // Registry of bond laws, keyed by the case-file name (dem.material.bond.law).
 // A law's own keys are declared by keys() beside its make() (schema section "bond (law: name)").

@@ -7,6 +7,7 @@
 // output rows' energies read from that record.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <memory>
@@ -382,6 +383,71 @@ TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   }
   EXPECT_EQ(one.total_energy, two.total_energy);
   EXPECT_EQ(one.total_energy, beam.energy(p));
+}
+
+// Two beam sets in two halves of a lattice (two materials, each set's bonds at half the DEs, so
+// at one thread's DEs on two threads): the one pass of both (accumulate_gathered_forces, what
+// DemModel runs for consecutive gather sets) adds to every DE what the two sets' own passes add
+// one after the other, to the bit, with the same measures and energies, on 1 and 2 threads.
+TEST(ForceScan, BeamSetsInOnePassAddWhatTheirOwnPassesAdd) {
+  DemModel model;
+  const double R = 1e-3, a = 2 * R;
+  build_lattice(model.particles, {0, 0, 0}, {16, 16, 16}, a, R, 7800.0);
+  ParticleSet& p = model.particles;
+  auto lower = std::make_unique<BeamBondSet>(BeamBondSet::Parameters{2e11, 0.3, 0.5, 1.0e9});
+  auto upper = std::make_unique<BeamBondSet>(BeamBondSet::Parameters{1e11, 0.25, 0.4, 0.8e9});
+  for (auto [i, j] : close_pairs(p, 0.01)) (p.position[i].z + p.position[j].z < 15 * a ? *lower : *upper).add(i, j, p);
+  const BondSet& lower_set = model.add_bond_set(std::move(lower));
+  const BondSet& upper_set = model.add_bond_set(std::move(upper));
+  model.finalize();
+  perturb(p, a);
+  struct Pass {
+    std::vector<Vec3> force, torque;
+    std::vector<Sym3> virial;
+    std::vector<double> energy;  // per bond of both sets
+    std::vector<BreakEvent> events;
+  };
+  const auto pass = [&](int threads, bool together) {
+    const test::OmpThreads scope(threads);
+    Pass out;
+    out.virial.assign(p.size(), Sym3{});
+    ForceScan scan = criterion_scan();
+    scan.virial = out.virial;
+    scan.energy = true;
+    p.clear_forces();
+    const BondSet* sets[] = {&lower_set, &upper_set};
+    if (together) accumulate_gathered_forces(sets, p, scan);
+    else
+      for (const BondSet* set : sets) set->accumulate_forces(p, scan);
+    out.force = p.force;
+    out.torque = p.torque;
+    for (std::uint32_t s = 0; s < 2; ++s) {
+      out.energy.insert(out.energy.end(), sets[s]->recorded_energies().begin(), sets[s]->recorded_energies().end());
+      sets[s]->find_failures(p, s, 0.0, out.events);
+    }
+    return out;
+  };
+  ASSERT_GT(lower_set.size(), 5000u);
+  ASSERT_GT(upper_set.size(), 5000u);
+  EXPECT_TRUE(lower_set.runs_on_threads() && upper_set.runs_on_threads());
+  const Pass separate = pass(1, false);
+  for (int threads : {1, 2}) {
+    const Pass together = pass(threads, true);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      ASSERT_EQ(separate.force[i], together.force[i]) << i << ", " << threads << " thread(s)";
+      ASSERT_EQ(separate.torque[i], together.torque[i]) << i << ", " << threads << " thread(s)";
+      ASSERT_EQ(separate.virial[i], together.virial[i]) << i << ", " << threads << " thread(s)";
+    }
+    EXPECT_EQ(separate.energy, together.energy) << threads << " thread(s)";
+    ASSERT_EQ(separate.events.size(), together.events.size()) << threads << " thread(s)";
+    for (std::size_t k = 0; k < separate.events.size(); ++k) {
+      EXPECT_EQ(separate.events[k].set, together.events[k].set);
+      EXPECT_EQ(separate.events[k].bond, together.events[k].bond);
+      EXPECT_EQ(separate.events[k].stress, together.events[k].stress);
+    }
+  }
+  for (std::uint32_t s = 0; s < 2; ++s)  // the perturbation overloads some bonds of each set
+    EXPECT_TRUE(std::any_of(separate.events.begin(), separate.events.end(), [s](const BreakEvent& e) { return e.set == s; })) << s;
 }
 
 // Whole steps of a damped breakable model on 1 and 2 threads: beams with BBF, springs with a
