@@ -4,6 +4,8 @@
 // each backend (our LDL^T, PETSc's direct and an iterative PETSc solve).
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "common/error.hpp"
 #include "coupling/multiplier_solver.hpp"
 #include "support/omp_threads.hpp"
@@ -99,14 +101,14 @@ TEST(CouplingMultiplierSolver, ARowThatNothingCanMeetIsNotSilentlyAccepted) {
 }
 
 namespace {
-// 30 DEs on 8 nodes, fine mediator, each DE interpolated from three nodes with positive weights
-// summing to 1; node 2 held along y.
 struct SharedNodes {
   CouplingOperators fine;
   std::vector<double> md, mc;
 };
-SharedNodes shared_nodes() {
-  const int np = 30, nn = 8;
+// np DEs on nn nodes, fine mediator, DE p interpolated from the three nodes reach(p) with
+// positive weights summing to 1; DE masses ~0.1 mg, node masses ~5 mg.
+template <class Reach>
+SharedNodes fine_operators(int np, int nn, Reach&& reach) {
   CouplingOperators fine;
   fine.settings.mediator = Mediator::fine;
   fine.N.resize(np, nn);
@@ -117,18 +119,23 @@ SharedNodes shared_nodes() {
     fine.particles.push_back(static_cast<std::uint32_t>(p));
     const double w = 1e-9 * (1.0 + 0.5 * std::sin(p));  // m^3, a DE's share of the overlap
     const double a = 0.2 + 0.1 * std::cos(3.0 * p), b = 0.3;
-    const int nodes[3] = {p % nn, (p + 3) % nn, (p + 5) % nn};
+    const std::array<int, 3> nodes = reach(p);
     const double N[3] = {a, b, 1.0 - a - b};
     fine.Gd.insert(p, p) = w;
     for (int k = 0; k < 3; ++k) {
       fine.N.insert(p, nodes[k]) = N[k];
       fine.Gc.insert(p, nodes[k]) = -w * N[k];
     }
-    md[p] = 1.0 / (1e-7 * (1.0 + 0.3 * std::cos(p)));  // DE masses ~0.1 mg
+    md[p] = 1.0 / (1e-7 * (1.0 + 0.3 * std::cos(p)));
   }
-  for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * (d / 3)));  // node masses ~5 mg
-  mc[3 * 2 + 1] = 0.0;  // node 2 held along y
+  for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * (d / 3 % 8)));
   return {fine, md, mc};
+}
+// 30 DEs on 8 nodes, DE p on nodes p, p + 3 and p + 5 (mod 8); node 2 held along y.
+SharedNodes shared_nodes() {
+  SharedNodes s = fine_operators(30, 8, [](int p) { return std::array<int, 3>{p % 8, (p + 3) % 8, (p + 5) % 8}; });
+  s.mc[3 * 2 + 1] = 0.0;
+  return s;
 }
 }  // namespace
 
@@ -165,27 +172,10 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
 // = 0 after the projection, and the bits are the same on 1 and 2 threads.
 TEST(CouplingMultiplierSolver, TwoBodiesAreSolvedInTwoIndependentParts) {
   const int bodies = 2, nodes = 400, des = 900, np = bodies * des, nn = bodies * nodes;
-  CouplingOperators fine;
-  fine.settings.mediator = Mediator::fine;
-  fine.N.resize(np, nn);
-  fine.Gd.resize(np, np);
-  fine.Gc.resize(np, nn);
-  std::vector<double> md(np), mc(3 * nn);
-  for (int p = 0; p < np; ++p) {
-    fine.particles.push_back(static_cast<std::uint32_t>(p));
-    const double w = 1e-9 * (1.0 + 0.5 * std::sin(p));
-    const double a = 0.2 + 0.1 * std::cos(3.0 * p), b = 0.3;
-    const int first = (p / des) * nodes, k = (p % des) * 7 % nodes;  // a chain through the body's nodes
-    const int at[3] = {first + k, first + (k + 1) % nodes, first + (k + 2) % nodes};
-    const double N[3] = {a, b, 1.0 - a - b};
-    fine.Gd.insert(p, p) = w;
-    for (int q = 0; q < 3; ++q) {
-      fine.N.insert(p, at[q]) = N[q];
-      fine.Gc.insert(p, at[q]) = -w * N[q];
-    }
-    md[p] = 1.0 / (1e-7 * (1.0 + 0.3 * std::cos(p)));
-  }
-  for (int d = 0; d < 3 * nn; ++d) mc[d] = 1.0 / (5e-6 * (1.0 + 0.1 * std::sin(d / 3)));
+  const auto [fine, md, mc] = fine_operators(np, nn, [](int p) {  // a chain through the body's nodes
+    const int first = (p / des) * nodes, k = (p % des) * 7 % nodes;
+    return std::array<int, 3>{first + k, first + (k + 1) % nodes, first + (k + 2) % nodes};
+  });
   CouplingOperators general = fine;
   general.settings.mediator = Mediator::coarse;  // the general factor (see above)
   const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);

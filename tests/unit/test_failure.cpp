@@ -309,6 +309,17 @@ TEST(BondColouring, ColoursAStarOfThreeHundredBondsAndKeepsEachDeSBondsApart) {
 }
 
 #ifdef _OPENMP
+// A force pass that records everything (measures, virials into `virial`, zeroed, and energies),
+// on p with its forces cleared.
+ForceScan recording_scan(ParticleSet& p, std::vector<Sym3>& virial) {
+  virial.assign(p.size(), Sym3{});
+  ForceScan scan = criterion_scan();
+  scan.virial = virial;
+  scan.energy = true;
+  p.clear_forces();
+  return scan;
+}
+
 // The force pass with a failure scan runs the colours' bonds on threads (BondColouring):
 // forces, torques, BBF measures and virials are the same to the bit on 1 and 2 threads, and so
 // are the failures found.
@@ -330,11 +341,7 @@ TEST(ForceScan, ForcesMeasuresAndVirialsAreTheSameOnAnyThreadCount) {
   const auto pass = [&](int threads) {
     const test::OmpThreads scope(threads);
     Pass out;
-    out.virial.assign(p.size(), Sym3{});
-    ForceScan scan = criterion_scan();
-    scan.virial = out.virial;
-    scan.energy = true;
-    p.clear_forces();
+    const ForceScan scan = recording_scan(p, out.virial);
     beam.accumulate_forces(p, scan);
     beam.find_failures(p, 0, 0.0, out.events);
     out.force = p.force;
@@ -410,11 +417,7 @@ TEST(ForceScan, BeamSetsInOnePassAddWhatTheirOwnPassesAdd) {
   const auto pass = [&](int threads, bool together) {
     const test::OmpThreads scope(threads);
     Pass out;
-    out.virial.assign(p.size(), Sym3{});
-    ForceScan scan = criterion_scan();
-    scan.virial = out.virial;
-    scan.energy = true;
-    p.clear_forces();
+    const ForceScan scan = recording_scan(p, out.virial);
     const BondSet* sets[] = {&lower_set, &upper_set};
     if (together) accumulate_gathered_forces(sets, p, scan);
     else
