@@ -358,8 +358,11 @@ void DemModel::update_neighbours() {
 double DemModel::compute_forces(const ForceScan& scan, bool cleared) {
   if (!cleared) particles.clear_forces();
   for (std::size_t s = 0; s < bond_sets_.size(); s += pass_sets_[s]) {
-    const PhaseTimer timer(profile_, profile_ ? phase_.bonds[s] : 0, runs_threaded(bond_sets_[s]->runs_on_threads()));
-    if (pass_sets_[s] > 1) accumulate_gathered_forces({&set_pointers_[s], pass_sets_[s]}, particles, scan);
+    const std::span<const BondSet* const> pass(&set_pointers_[s], pass_sets_[s]);
+    const bool together = pass.size() > 1;
+    const bool threaded = together ? gathered_pass_threaded(pass, particles.size()) : bond_sets_[s]->runs_on_threads();
+    const PhaseTimer timer(profile_, profile_ ? phase_.bonds[s] : 0, runs_threaded(threaded));
+    if (together) accumulate_gathered_forces(pass, particles, scan);
     else bond_sets_[s]->accumulate_forces(particles, scan);
   }
   if (!contact_) return 0.0;

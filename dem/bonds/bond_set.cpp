@@ -60,10 +60,14 @@ std::vector<std::uint32_t> BondSet::order_pairs_by_first(std::size_t n_particles
 
 void BondSet::not_a_gather_pass() { throw std::logic_error("BondSet: a gather pass's half called on a set that does not gather"); }
 
-void accumulate_gathered_forces(std::span<const BondSet* const> sets, ParticleSet& p, const ForceScan& scan) {
+bool gathered_pass_threaded(std::span<const BondSet* const> sets, std::size_t n_particles) {
   std::size_t bonds = 0;
   for (const BondSet* set : sets) bonds += set->size();
-  run_threaded_if(BondColouring::worth_threads(bonds, 1, p.size()), [&] {
+  return BondColouring::worth_threads(bonds, 1, n_particles);
+}
+
+void accumulate_gathered_forces(std::span<const BondSet* const> sets, ParticleSet& p, const ForceScan& scan) {
+  run_threaded_if(gathered_pass_threaded(sets, p.size()), [&] {
     const IndexRange des = thread_share(static_cast<long>(p.size()));
     for (const BondSet* set : sets) set->evaluate_share(p, scan, des);
 #pragma omp barrier

@@ -234,6 +234,8 @@ class BondSet {
 // part of the scene (one material of several) has them all at the DEs of a few threads: a pass
 // of its own would leave the other threads waiting at its barrier.
 void accumulate_gathered_forces(std::span<const BondSet* const> sets, ParticleSet& p, const ForceScan& scan);
+// Whether that pass runs on the threads: all its bonds as one colour (BondColouring::worth_threads).
+bool gathered_pass_threaded(std::span<const BondSet* const> sets, std::size_t n_particles);
 
 // Registry of bond laws, keyed by the case-file name (dem.material.bond.law).
 // A law's own keys are declared by keys() beside its make() (schema section "bond (law: name)").
