@@ -220,22 +220,7 @@ void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matr
   w_.resize(k, 3);
   multiply<3>(a.Ut, y_.data(), 3, w_.data());  // U^T y, then w = K^-1 U^T y, every system at once
   w_.array() *= a.movable.array();
-  const int systems = static_cast<int>(a.K.size());
-  blocks_.resize(a.K.size());
-  for (int s = 0; s < systems; ++s) {
-    const auto [served, width] = served_by(s);
-    std::vector<double>& block = blocks_[static_cast<std::size_t>(s)];
-    block.resize(static_cast<std::size_t>(k * width));
-    for (Eigen::Index j = 0; j < k; ++j)
-      for (int m = 0; m < width; ++m) block[static_cast<std::size_t>(j * width + m)] = w_(j, served[static_cast<std::size_t>(m)]);
-  }
-  solve_blocks(a.K);
-  for (int s = 0; s < systems; ++s) {
-    const auto [served, width] = served_by(s);
-    const std::vector<double>& block = blocks_[static_cast<std::size_t>(s)];
-    for (Eigen::Index j = 0; j < k; ++j)
-      for (int m = 0; m < width; ++m) w_(j, served[static_cast<std::size_t>(m)]) = block[static_cast<std::size_t>(j * width + m)];
-  }
+  solve_systems(a.K, w_, w_, nullptr);
   lambda.resize(rows, 3);
   multiply<3>(a.U, w_.data(), 3, lambda.data());  // U w
   for_each_index(rows, rows > parallel_threshold, [&](long r) {  // lambda = y - D^-1 U w
@@ -357,23 +342,7 @@ void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
     }
     return;
   }
-  blocks_.resize(static_cast<std::size_t>(systems_));
-  for (int k = 0; k < systems_; ++k) {
-    const auto [served, width] = served_by(k);
-    std::vector<double>& block = blocks_[static_cast<std::size_t>(k)];
-    block.resize(static_cast<std::size_t>(rows * width));
-    const double* scale = scales_[k].data();
-    for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s) block[static_cast<std::size_t>(r * width + s)] = rhs(r, served[static_cast<std::size_t>(s)]) * scale[r];
-  }
-  solve_blocks(factors_);
-  for (int k = 0; k < systems_; ++k) {
-    const auto [served, width] = served_by(k);
-    const std::vector<double>& block = blocks_[static_cast<std::size_t>(k)];
-    const double* scale = scales_[k].data();
-    for (Eigen::Index r = 0; r < rows; ++r)
-      for (int s = 0; s < width; ++s) lambda(r, served[static_cast<std::size_t>(s)]) = block[static_cast<std::size_t>(r * width + s)] * scale[r];
-  }
+  solve_systems(factors_, rhs, lambda, &scales_);
 }
 
 MultiplierSolver::ForestFactor MultiplierSolver::forest_of(std::unique_ptr<Factor> factor) {
@@ -405,8 +374,23 @@ MultiplierSolver::ForestFactor MultiplierSolver::forest_of(std::unique_ptr<Facto
   return f;
 }
 
-void MultiplierSolver::solve_blocks(const std::vector<ForestFactor>& factors) const {
+void MultiplierSolver::solve_systems(const std::vector<ForestFactor>& factors, const Matrix3& in, Matrix3& out,
+                                     const std::vector<Eigen::VectorXd>* scales) const {
   const auto systems = static_cast<int>(factors.size());
+  const Eigen::Index rows = in.rows();
+  // Each system's components of `in` (scaled) into its block, row-major.
+  blocks_.resize(factors.size());
+  for (int s = 0; s < systems; ++s) {
+    const auto [served, width] = served_by(s);
+    std::vector<double>& block = blocks_[static_cast<std::size_t>(s)];
+    block.resize(static_cast<std::size_t>(rows * width));
+    const double* scale = scales ? (*scales)[static_cast<std::size_t>(s)].data() : nullptr;
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (int m = 0; m < width; ++m) {
+        const double v = in(r, served[static_cast<std::size_t>(m)]);
+        block[static_cast<std::size_t>(r * width + m)] = scale ? v * scale[r] : v;
+      }
+  }
   block_scratch_.resize(factors.size());
   std::array<long, 4> first_task{};  // system s's tasks are [first_task[s], first_task[s + 1]) of all
   long nonzeros = 0;
@@ -436,11 +420,18 @@ void MultiplierSolver::solve_blocks(const std::vector<ForestFactor>& factors) co
       });
     }
   });
+  // The solutions back, each system's into its components of `out` (scaled).
+  out.resize(rows, 3);
   for (int s = 0; s < systems; ++s) {
     const auto z = static_cast<std::size_t>(s);
-    with_width(served_by(s).second, [&](auto width) {
-      store_permuted<decltype(width)::value>(*factors[z].factor, block_scratch_[z], blocks_[z].data());
-    });
+    const auto [served, width] = served_by(s);
+    with_width(width, [&](auto w) { store_permuted<decltype(w)::value>(*factors[z].factor, block_scratch_[z], blocks_[z].data()); });
+    const double* scale = scales ? (*scales)[z].data() : nullptr;
+    for (Eigen::Index r = 0; r < rows; ++r)
+      for (int m = 0; m < width; ++m) {
+        const double v = blocks_[z][static_cast<std::size_t>(r * width + m)];
+        out(r, served[static_cast<std::size_t>(m)]) = scale ? v * scale[r] : v;
+      }
   }
 }
 

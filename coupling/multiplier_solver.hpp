@@ -124,9 +124,11 @@ class MultiplierSolver {
   // lambda = A^-1 rhs, every system at once: the products with U and U^T read U once for the
   // three components; with `dc`, dc = M_c^-1 G_c^T lambda on U's columns (the rest untouched).
   void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
-  // blocks_[s] = A_s^-1 blocks_[s] for every system s (blocks_[s] row-major, one column per
-  // component the system serves), A_s = factors[s]: the tasks of all the systems on the threads.
-  void solve_blocks(const std::vector<ForestFactor>& factors) const;
+  // out = A_s^-1 in in the components each system s serves, A_s = factors[s], every system at
+  // once (the tasks of all of them on the threads); with `scales`, A_s is the scaled S A S and
+  // in and out are scaled by S (scales[s] per row). out may be in.
+  void solve_systems(const std::vector<ForestFactor>& factors, const Matrix3& in, Matrix3& out,
+                     const std::vector<Eigen::VectorXd>* scales) const;
   // The components system k serves (the first `width` entries) and their number.
   std::pair<std::array<int, 3>, int> served_by(int k) const;
   // The system of an earlier component with the same ties and the same continuum inverse masses

@@ -119,14 +119,10 @@ void DemModel::finalize() {
   for (auto& set : bond_sets_) set->finalize(particles.size());
   set_pointers_.clear();
   pass_sets_.assign(bond_sets_.size(), 1);
-  for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
+  for (std::size_t s = 0, first = 0; s < bond_sets_.size(); ++s) {
     set_pointers_.push_back(bond_sets_[s].get());
-    if (s > 0 && bond_sets_[s]->gathers() && bond_sets_[s - 1]->gathers()) {
-      std::size_t first = s - 1;
-      while (pass_sets_[first] == 0) --first;
-      ++pass_sets_[first];
-      pass_sets_[s] = 0;
-    }
+    if (s > 0 && bond_sets_[s]->gathers() && bond_sets_[s - 1]->gathers()) ++pass_sets_[first], pass_sets_[s] = 0;
+    else first = s;
   }
   if (neighbours_) {
     neighbours_->set_exclusions(intact_bonded_pairs());
