@@ -460,7 +460,9 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
   residual(vd, vc, rhs_);
   if (dc.rows() != GcT_.rows()) dc.setZero(GcT_.rows(), 3);
-  if (low_rank_) {  // the solve leaves M_c^-1 G_c^T lambda on U's columns; the other corrected nodes are held: 0
+  // The Woodbury solve leaves M_c^-1 G_c^T lambda on U's columns; a corrected node not among them
+  // (held, or reached only by rows left free in the components it moves in) keeps dc's 0.
+  if (low_rank_) {
     solve_low_rank(*low_rank_, rhs_, lambda, &dc);
   } else {
     solve(rhs_, lambda);

@@ -76,9 +76,11 @@ class MultiplierSolver {
   void solve(const Matrix3& rhs, Matrix3& lambda) const;
   // out = G_d vd + G_c vc (rows x 3), 0 in the components a row leaves free.
   void residual(const Matrix3& vd, const Eigen::Ref<const Matrix3>& vc, Matrix3& out) const;
-  // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda. dc is
-  // written on corrected_nodes() only, and set to 0 when it is resized: a caller that keeps it
-  // between calls (and changes it only there) reads the whole correction in it.
+  // Projects (vd, vc) onto ker G; lambda and the corrections dd, dc = M^-1 G^T lambda. dc is set
+  // to 0 when it is resized and is not 0 only on corrected_nodes(): the general solve writes every
+  // row, the Woodbury form only U's columns (0 in a component a node is held in). A
+  // caller that keeps dc between calls (and changes it only on corrected_nodes()) reads the
+  // whole correction in it.
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
   // The continuum nodes a projection can correct (those G_c reaches), in increasing order.
   const std::vector<int>& corrected_nodes() const { return corrected_nodes_; }

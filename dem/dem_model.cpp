@@ -182,13 +182,13 @@ double DemModel::critical_time_step() const {
 }
 
 void DemModel::set_profile(StepProfile* profile) {
+  if (profile && pass_sets_.size() != bond_sets_.size()) throw std::logic_error("DemModel: set_profile before finalize()");
   profile_ = profile;
   if (!profile) return;
   phase_.kick = profile->phase("kicks");
   phase_.drift = profile->phase("drift and clear forces");
   phase_.boundary = profile->phase("boundary conditions");
   if (neighbours_) phase_.neighbours = profile->phase("neighbour list");
-  if (pass_sets_.size() != bond_sets_.size()) throw std::logic_error("DemModel: set_profile before finalize()");
   phase_.bonds.assign(bond_sets_.size(), 0);
   for (std::size_t s = 0; s < bond_sets_.size(); ++s) {
     if (pass_sets_[s] == 0) continue;  // in an earlier set's pass
@@ -352,6 +352,7 @@ void DemModel::update_neighbours() {
 }
 
 double DemModel::compute_forces(const ForceScan& scan, bool cleared) {
+  if (pass_sets_.size() != bond_sets_.size()) throw std::logic_error("DemModel: a force pass before finalize()");
   if (!cleared) particles.clear_forces();
   for (std::size_t s = 0; s < bond_sets_.size(); s += pass_sets_[s]) {
     const std::span<const BondSet* const> pass(&set_pointers_[s], pass_sets_[s]);

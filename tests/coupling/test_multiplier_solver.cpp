@@ -7,6 +7,7 @@
 #include <array>
 
 #include "common/error.hpp"
+#include "common/parallel.hpp"
 #include "coupling/multiplier_solver.hpp"
 #include "support/omp_threads.hpp"
 
@@ -167,11 +168,14 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
 }
 
 // Two bodies coupled apart (the DCB's two arms): K falls into two blocks, its factor's
-// elimination forest into two trees of 400 columns, and the Woodbury form solves them as two
+// elimination forest into two trees of 1500 columns, and the Woodbury form solves them as two
 // independent parts, on the threads. The multipliers are the general factor's to round-off, G v
-// = 0 after the projection, and the bits are the same on 1 and 2 threads.
+// = 0 after the projection, and the bits are the same on 1 and 2 threads. Sized so that the
+// solves and the per-row loops run on the threads (their factors' non-zeros and the rows above
+// parallel_threshold): at 400 columns a body everything ran on one thread either way.
 TEST(CouplingMultiplierSolver, TwoBodiesAreSolvedInTwoIndependentParts) {
-  const int bodies = 2, nodes = 400, des = 900, np = bodies * des, nn = bodies * nodes;
+  const int bodies = 2, nodes = 1500, des = 3400, np = bodies * des, nn = bodies * nodes;
+  static_assert(bodies * des > arlequin::parallel_threshold);
   const auto [fine, md, mc] = fine_operators(np, nn, [](int p) {  // a chain through the body's nodes
     const int first = (p / des) * nodes, k = (p % des) * 7 % nodes;
     return std::array<int, 3>{first + k, first + (k + 1) % nodes, first + (k + 2) % nodes};

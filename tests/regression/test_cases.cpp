@@ -959,9 +959,10 @@ TEST(Cases, ProfilePrintsThePhasesOfTheStep) {
 
 // Results independent of the thread count, to the bit, for whole runs (not only the bond pass):
 // a breaking lattice bar, the bonded block of the benchmark (20 000 DEs: its kicks and drift on
-// threads too) and a coupled bar, each large enough that its bond pass runs on threads (above
-// common/parallel.hpp's threshold), on one and two threads: series.csv and breaks.csv byte for
-// byte. (The REV's failure test: RevFailure.RunsAreBitIdenticalOnOneAndTwoThreads.)
+// threads too), a coupled bar, the coupled fabric and the first steps of the coupled DCB, each
+// large enough that its bond pass runs on threads (above common/parallel.hpp's threshold), on one
+// and two threads: series.csv and breaks.csv byte for byte. (The REV's failure test:
+// RevFailure.RunsAreBitIdenticalOnOneAndTwoThreads.)
 TEST(Cases, WholeRunsAreBitIdenticalOnOneAndTwoThreads) {
   struct Run {
     std::string name, args;
@@ -978,7 +979,13 @@ TEST(Cases, WholeRunsAreBitIdenticalOnOneAndTwoThreads) {
        true},
       // The finite-strain P2 plate (its tiles and gather on threads), the low-rank multipliers,
       // weighted contacts, to just past the first breaks (30 us).
-      {"fabric_impact_coupled", "fabric_impact_coupled/case.yaml --set time.end=3.2e-5", true}};
+      {"fabric_impact_coupled", "fabric_impact_coupled/case.yaml --set time.end=3.2e-5", true},
+      // The coupled DCB at 40k: the coupling's per-DE and per-node loops (5142 coupled DEs, above
+      // the threshold), the multipliers' solves in two parts (one per arm), beam sets in one
+      // pass and cohesive links; its packing built once into the scratch folder (about 25 s).
+      {"dcb_coupled", "dcb_coupled/case.yaml --steps 400 --set output.every=1.0e-7 --set dem.sample.file=" +
+                          (test::scratch_dir("threads_dcb_coupled_sample") / "sample.h5").string(),
+       true}};
   for (const Run& run : runs) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
     if (run.needs_continuum) continue;

@@ -176,6 +176,27 @@ TEST(BeamBlock, EachLaneIsItsOwnBond) {
   }
 }
 
+// A force pass needs finalize() (the bonds' order, their passes): asked before it, it says so
+// instead of reading the passes' empty lists.
+TEST(BeamChain, AForcePassBeforeFinalizeIsRefused) {
+  DemModel model;
+  build_chain(model.particles, {0, 0, 0}, {1, 0, 0}, 3, 2e-3, 1e-3, 7800.0);
+  test::bond_all_touching(model, {1e11, 0.3, 0.5});
+  const auto refusal = [](auto&& call) {
+    try {
+      call();
+    } catch (const std::logic_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("none");
+  };
+  EXPECT_EQ(refusal([&] { model.step(1e-9); }), "DemModel: a force pass before finalize()");
+  StepProfile profile;
+  EXPECT_EQ(refusal([&] { model.set_profile(&profile); }), "DemModel: set_profile before finalize()");
+  model.finalize();
+  EXPECT_EQ(refusal([&] { model.step(1e-9); }), "none");
+}
+
 // R1 chain: 10 bonds (20 mm), clamped, 0.01 N sideways at the tip, relaxed with viscous
 // damping: tip deflection P L^3/(3EI) = 5.432489e-3 mm and rotation P L^2/(2EI) =
 // 4.074367e-4 rad to 1e-4 (SI units here: the deflection is in m).
