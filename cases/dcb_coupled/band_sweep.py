@@ -20,16 +20,16 @@ folder), the pure run the 20k load lines, --set "groups=$G" with G the third ent
 cases/dcb/sweep_groups.txt, and the sweep the 20k arm's bending modulus, --set
 continuum.material.E=9.8e10 (cases/dcb/README.md).
 
-For each run: the band (half-thickness and overlap width, from its resolved case), its DEs and the
-continuum's degrees of freedom, and its compute time (the time loop less its output) brought to
-the earliest end time of the runs compared (a step costs about the same all along a run), and
-against the pure-DEM run, over its rows with Delta in [0.5, 2.0] mm, the run's load at their
-times (both impose the same Delta(t)): the load as docs/decisions.md#d51 compares it,
+For each run: the band (half-thickness and overlap width, from its resolved case), the arms' mesh,
+its DEs and the continuum's degrees of freedom, and its compute time (the time loop less its
+output) brought to the earliest end time of the runs compared (a step costs about the same all
+along a run), and against the pure-DEM run, over its rows with Delta in [0.5, 2.0] mm, the run's
+load at their times (both impose the same Delta(t)): the load as docs/decisions.md#d51 compares it,
 max |P - P_pure| / max P_pure, and row by row, max |P / P_pure - 1|; the peak load, and the
 interface's dissipated energy at Delta = 2.0 mm; and P against LEFM (R5: the largest
 |P / P_LEFM - 1| over Delta in [0.75, 2.0] mm, from the run's own check). The pure run is the
-table's first row. Prints a Markdown table and writes band_sweep.csv and band_sweep.png (the
-load's and the energy's difference against compute time) into the sweep folder.
+table's first row. Prints a Markdown table and writes band_sweep.csv and band_sweep.png (the load's
+and the energy's difference against compute time) into the sweep folder.
 """
 
 import sys
@@ -63,11 +63,13 @@ def section_of(run, name):
 
 
 def label_of(run):
-    """"pure DEM", or the band's half-thickness / overlap width in mm and, if not fe, the solver."""
+    """"pure DEM", or the band's half-thickness / overlap width in mm, the arms' mesh (its file's
+    name) and, if not fe, the solver."""
     band = section_of(run, "band")
     if band is None:
         return "pure DEM"
     label = f"{1e3 * float(band['half_thickness']):.2f} / {1e3 * float(band['width']):.2f} mm"
+    label += ", " + Path(section_of(run, "mesh")["file"]).stem
     solver = section_of(run, "continuum")["solver"]
     return label if solver == "fe" else f"{label}, {solver}"
 
