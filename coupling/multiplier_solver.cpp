@@ -33,7 +33,8 @@ struct SolveRow<4> {
 // components that share A solved together: L is read once for all of them), in three parts:
 // load_permuted puts X into the scratch y = P X, solve_columns runs the triangular solves over
 // one task's columns (MultiplierSolver::ForestFactor: trees of the elimination forest, which
-// read and write only their own rows of y), store_permuted puts y back, X = P^T y. The solves
+// read and write only their own rows of y; within a tree, supernodes of columns that share
+// their rows), store_permuted puts y back, X = P^T y. The solves
 // are spelled out over L's columns (Eigen's solve takes one column at a time, and applies the
 // inverse permutation in place, which allocates a mask each call). A row of the scratch is one
 // small vector (width 3 padded to 4, 1 to 2), so an entry of L costs one vector multiply-add for
@@ -57,9 +58,90 @@ void load_permuted(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, 
   });
 }
 
+// One supernode's part of the forward solve L y' = y: its K columns j0 .. j0 + K - 1 hold, below
+// their triangle, the same rows (MultiplierSolver::ForestFactor). The triangle first, column by
+// column; then each shared row's K updates at once, its row of y read and written once, not K
+// times. Each row takes its updates from the columns in increasing order, as a column-by-column
+// pass gives them: the same bits.
+template <int K, int width>
+void forward_supernode(const int* outer, const int* inner, const double* value, int j0, double* scratch) {
+  using Row = RowOf<width>;  // named here: as a template argument the type would lose its alignment
+  Row* y = reinterpret_cast<Row*>(scratch);
+  for (int c = 0; c < K; ++c) {  // the triangle: column j0 + c's first K - 1 - c rows are j0 + c + 1 ...
+    const Row yc = y[j0 + c];
+    for (int p = outer[j0 + c]; p < outer[j0 + c] + (K - 1 - c); ++p) y[inner[p]] -= value[p] * yc;
+  }
+  Row yk[K];
+  const double* column[K];  // column j0 + c from its entry in the first shared row
+  for (int c = 0; c < K; ++c) {
+    yk[c] = y[j0 + c];
+    column[c] = value + outer[j0 + c] + (K - 1 - c);
+  }
+  const int* rows = inner + outer[j0 + K - 1];
+  const int shared = outer[j0 + K] - outer[j0 + K - 1];
+  for (int q = 0; q < shared; ++q) {
+    Row acc = y[rows[q]];
+    for (int c = 0; c < K; ++c) acc -= column[c][q] * yk[c];
+    y[rows[q]] = acc;
+  }
+}
+
+// One supernode's part of the backward solve L^T y'' = y' (columns in decreasing order, each a dot
+// product over its rows): the shared rows' sums of all K columns at once, each row of y read once;
+// then each column's triangle, from the last column down (its rows' y final by then), and y[j] -=
+// shared sum + triangle sum. The sums are split into partial sums (one sum would wait on each add
+// in turn: the solve's critical path): four for a single column, two a column below four columns.
+template <int K, int width>
+void backward_supernode(const int* outer, const int* inner, const double* value, int j0, double* scratch) {
+  using Row = RowOf<width>;
+  Row* y = reinterpret_cast<Row*>(scratch);
+  constexpr int sums = K == 1 ? 4 : K < 4 ? 2 : 1;
+  const int* rows = inner + outer[j0 + K - 1];
+  const int shared = outer[j0 + K] - outer[j0 + K - 1];
+  const double* column[K];  // column j0 + c from its entry in the first shared row
+  for (int c = 0; c < K; ++c) column[c] = value + outer[j0 + c] + (K - 1 - c);
+  Row sum[sums][K] = {};
+  int q = 0;
+  for (; q + sums <= shared; q += sums)
+    for (int u = 0; u < sums; ++u) {
+      const Row yq = y[rows[q + u]];
+      for (int c = 0; c < K; ++c) sum[u][c] += column[c][q + u] * yq;
+    }
+  for (; q < shared; ++q)
+    for (int c = 0; c < K; ++c) sum[0][c] += column[c][q] * y[rows[q]];
+  for (int c = K - 1; c >= 0; --c) {
+    Row total = sums == 4 ? (sum[0][c] + sum[1][c]) + (sum[2][c] + sum[3][c]) : sums == 2 ? sum[0][c] + sum[1][c] : sum[0][c];
+    for (int p = outer[j0 + c]; p < outer[j0 + c] + (K - 1 - c); ++p) total += value[p] * y[inner[p]];
+    y[j0 + c] -= total;
+  }
+}
+
+// The most columns a supernode takes (a longer run of nested columns is cut into supernodes of
+// this size): the kernels above keep a row of y for each column in registers.
+constexpr int max_supernode = 8;
+
+// f(std::integral_constant<int, k>{}) for a supernode of k = 1 ... max_supernode columns.
+template <class F>
+void with_supernode_size(int k, F&& f) {
+  static_assert(max_supernode == 8);
+  switch (k) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    case 4: return f(std::integral_constant<int, 4>{});
+    case 5: return f(std::integral_constant<int, 5>{});
+    case 6: return f(std::integral_constant<int, 6>{});
+    case 7: return f(std::integral_constant<int, 7>{});
+    default: return f(std::integral_constant<int, 8>{});
+  }
+}
+
+// The triangular solves over one task's supernodes [first, last) (positions in `columns` at
+// supernode_start[s]), L y' = y, y' /= D, L^T y'' = y'. A row's updates come from the same
+// columns in the same order whichever tasks run and on which thread: the bits of one serial pass.
 template <int width>
 void solve_columns(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, const Eigen::VectorXd& D, const int* columns,
-                   const int* columns_end, std::vector<double>& scratch) {
+                   const int* supernode_start, int first, int last, std::vector<double>& scratch) {
   using Row = RowOf<width>;
   // L by columns, each holding only its rows below the diagonal (an LDL^T stores no unit diagonal)
   const auto& L = f.matrixL().nestedExpression();
@@ -67,22 +149,14 @@ void solve_columns(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, 
   const int* inner = L.innerIndexPtr();
   const double* value = L.valuePtr();
   Row* y = reinterpret_cast<Row*>(scratch.data());
-  for (const int* j = columns; j != columns_end; ++j) {  // L y' = y (L's rows in column j lie below j: y[j] is final)
-    const Row yj = y[*j];
-    for (int p = outer[*j]; p < outer[*j + 1]; ++p) y[inner[p]] -= value[p] * yj;
+  for (int s = first; s < last; ++s) {
+    const int k = supernode_start[s + 1] - supernode_start[s];
+    with_supernode_size(k, [&](auto size) { forward_supernode<decltype(size)::value, width>(outer, inner, value, columns[supernode_start[s]], scratch.data()); });
   }
-  for (const int* j = columns; j != columns_end; ++j) y[*j] /= D[*j];
-  // L^T y'' = y': a dot product per column, in four partial sums (one sum would wait on each
-  // add in turn: the solve's critical path).
-  constexpr int sums = 4;
-  for (const int* j = columns_end; j != columns;) {
-    --j;
-    Row sum[sums] = {};
-    int p = outer[*j];
-    for (; p + sums <= outer[*j + 1]; p += sums)
-      for (int u = 0; u < sums; ++u) sum[u] += value[p + u] * y[inner[p + u]];
-    for (; p < outer[*j + 1]; ++p) sum[0] += value[p] * y[inner[p]];
-    y[*j] -= (sum[0] + sum[1]) + (sum[2] + sum[3]);
+  for (int q = supernode_start[first]; q < supernode_start[last]; ++q) y[columns[q]] /= D[columns[q]];
+  for (int s = last - 1; s >= first; --s) {
+    const int k = supernode_start[s + 1] - supernode_start[s];
+    with_supernode_size(k, [&](auto size) { backward_supernode<decltype(size)::value, width>(outer, inner, value, columns[supernode_start[s]], scratch.data()); });
   }
 }
 
@@ -365,10 +439,31 @@ MultiplierSolver::ForestFactor MultiplierSolver::forest_of(std::unique_ptr<Facto
   f.columns.resize(static_cast<std::size_t>(n));
   std::vector<int> next(start.begin(), start.end() - 1);
   for (int j = 0; j < n; ++j) f.columns[static_cast<std::size_t>(next[static_cast<std::size_t>(tree[static_cast<std::size_t>(j)])]++)] = j;
-  // Whole trees, in order, into tasks of at least task_columns columns (the last may have fewer).
+  // Supernodes: column b = a + 1 continues a's supernode when a's rows are b and then b's rows (b is
+  // a's parent, in a's tree), up to max_supernode columns.
+  const auto continues = [&](int a, int b) {
+    const int rows = outer[a + 1] - outer[a];
+    return b == a + 1 && rows == outer[b + 1] - outer[b] + 1 && inner[outer[a]] == b &&
+           std::equal(inner + outer[a] + 1, inner + outer[a + 1], inner + outer[b]);
+  };
+  std::vector<int> supernode_of_position(static_cast<std::size_t>(n) + 1);
+  for (int q = 0; q < n; ++q) {
+    const auto z = static_cast<std::size_t>(q);
+    if (q == 0 || !continues(f.columns[z - 1], f.columns[z]) || q - f.supernode_start.back() == max_supernode)
+      f.supernode_start.push_back(q);
+    supernode_of_position[z] = static_cast<int>(f.supernode_start.size()) - 1;
+  }
+  f.supernode_start.push_back(n);
+  supernode_of_position[static_cast<std::size_t>(n)] = static_cast<int>(f.supernode_start.size()) - 1;
+  // Whole trees, in order, into tasks of at least task_columns columns (the last may have fewer);
+  // a tree starts a supernode.
   f.task_start.push_back(0);
+  int task_first_column = 0;
   for (std::size_t t = 1; t < start.size(); ++t)
-    if (start[t] - f.task_start.back() >= task_columns || t + 1 == start.size()) f.task_start.push_back(start[t]);
+    if (start[t] - task_first_column >= task_columns || t + 1 == start.size()) {
+      f.task_start.push_back(supernode_of_position[static_cast<std::size_t>(start[t])]);
+      task_first_column = start[t];
+    }
   f.D = factor->vectorD();
   f.factor = std::move(factor);
   return f;
@@ -413,10 +508,9 @@ void MultiplierSolver::solve_systems(const std::vector<ForestFactor>& factors, c
       while (i >= first_task[s + 1]) ++s;
       const ForestFactor& f = factors[s];
       const auto t = static_cast<std::size_t>(i - first_task[s]);
-      const int* columns = f.columns.data();
       with_width(served_by(static_cast<int>(s)).second, [&](auto width) {
-        solve_columns<decltype(width)::value>(*f.factor, f.D, columns + f.task_start[t], columns + f.task_start[t + 1],
-                                              block_scratch_[s]);
+        solve_columns<decltype(width)::value>(*f.factor, f.D, f.columns.data(), f.supernode_start.data(), f.task_start[t],
+                                              f.task_start[t + 1], block_scratch_[s]);
       });
     }
   });
@@ -438,14 +532,22 @@ void MultiplierSolver::solve_systems(const std::vector<ForestFactor>& factors, c
 std::string MultiplierSolver::backend() const {
   if (low_rank_) {
     long largest = 0;
-    std::size_t parts = 0;
+    std::size_t parts = 0, supernodes = 0;
+    int widest = 0;
     for (const auto& K : low_rank_->K) {
-      largest = std::max<long>(largest, K.factor->matrixL().nestedExpression().nonZeros());
+      const long nonzeros = K.factor->matrixL().nestedExpression().nonZeros();
+      if (nonzeros > largest) {
+        largest = nonzeros;
+        supernodes = K.supernode_start.size() - 1;
+      }
       parts += K.task_start.size() - 1;
+      for (std::size_t s = 0; s + 1 < K.supernode_start.size(); ++s)
+        widest = std::max(widest, K.supernode_start[s + 1] - K.supernode_start[s]);
     }
     return "diagonal + low rank (Woodbury), LDL^T of " + std::to_string(low_rank_->U.cols()) + " continuum nodes a system (" +
-           std::to_string(largest) + " non-zeros in the largest factor; the systems' solves in " + std::to_string(parts) +
-           " independent parts)";
+           std::to_string(largest) + " non-zeros in the largest factor, its columns in " + std::to_string(supernodes) +
+           " supernodes, the widest of all " + std::to_string(widest) + " columns; the systems' solves in " +
+           std::to_string(parts) + " independent parts)";
   }
   return petsc_.empty() ? "LDL^T" : "PETSc " + petsc_.front()->description();
 }

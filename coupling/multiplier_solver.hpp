@@ -100,11 +100,15 @@ class MultiplierSolver {
   // elimination forest (a column's parent is its first row below the diagonal, and every entry of
   // a column lies in the column's own tree), so that a tree's triangular solves read and write only
   // its own rows. Trees are grouped, in order, into tasks of at least `task_columns` columns.
+  // Within a tree, runs of consecutive columns j, j + 1, ... each of whose rows are the next
+  // column and then that column's rows (j + 1 the parent of j) make a supernode: below their
+  // triangle the same rows, which the solves read and write once for all its columns.
   struct ForestFactor {
     std::unique_ptr<Factor> factor;
     Eigen::VectorXd D;
-    std::vector<int> columns;     // L's columns tree by tree, each tree's in increasing order
-    std::vector<int> task_start;  // task t: columns[task_start[t] .. task_start[t + 1])
+    std::vector<int> columns;          // L's columns tree by tree, each tree's in increasing order
+    std::vector<int> supernode_start;  // supernode s: columns[supernode_start[s] .. supernode_start[s + 1])
+    std::vector<int> task_start;       // task t: supernodes task_start[t] .. task_start[t + 1] - 1
   };
   static constexpr int task_columns = 256;
   // The forest of a computed factor.
