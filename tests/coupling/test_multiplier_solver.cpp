@@ -138,6 +138,26 @@ SharedNodes shared_nodes() {
   s.mc[3 * 2 + 1] = 0.0;
   return s;
 }
+
+// Velocities of np DEs and nn nodes, mixed in sign and size: z of DE p is 0.5 - drift p, x and y
+// of node i are (scale i, -2 scale i).
+void mixed_velocities(Eigen::Index np, Eigen::Index nn, double drift, double scale, Matrix3& vd, Matrix3& vc) {
+  vd.resize(np, 3);
+  vc.resize(nn, 3);
+  for (Eigen::Index p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - drift * p;
+  for (Eigen::Index i = 0; i < nn; ++i) vc.row(i) << scale * i, -2.0 * scale * i, std::sin(i);
+}
+
+// A solver's projection of (vd, vc): the projected velocities and the multipliers.
+struct Projected {
+  Matrix3 vd, vc, lambda;
+};
+Projected projected(const MultiplierSolver& solver, const Matrix3& vd, const Matrix3& vc) {
+  Projected out{vd, vc, {}};
+  Matrix3 dd, dc;
+  solver.project(out.vd, out.vc, dd, dc, out.lambda);
+  return out;
+}
 }  // namespace
 
 // The fine mediator (G_d = W diagonal, G_c = -W N) is solved by the Woodbury form; the same
@@ -154,17 +174,15 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
   EXPECT_EQ(woodbury.systems(), 2);  // y differs from x, z reuses x's
 
-  Matrix3 vd(np, 3), vc(nn, 3);
-  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
-  for (int i = 0; i < nn; ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
-  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc, dd, dc, lambda_w, lambda_f, residual;
-  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
-  factor.project(vd_f, vc_f, dd, dc, lambda_f);
-  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
-  EXPECT_LT((vd_w - vd_f).norm(), 1e-10 * vd.norm());
-  woodbury.residual(vd_w, vc_w, residual);
+  Matrix3 vd, vc;
+  mixed_velocities(np, nn, 0.03, 0.1, vd, vc);
+  const Projected w = projected(woodbury, vd, vc), f = projected(factor, vd, vc);
+  EXPECT_LT((w.lambda - f.lambda).norm(), 1e-10 * f.lambda.norm());
+  EXPECT_LT((w.vd - f.vd).norm(), 1e-10 * vd.norm());
+  Matrix3 residual;
+  woodbury.residual(w.vd, w.vc, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
-  EXPECT_EQ(vc_w(2, 1), vc(2, 1));                      // the held dof
+  EXPECT_EQ(w.vc(2, 1), vc(2, 1));                      // the held dof
 }
 
 // Two bodies coupled apart (the DCB's two arms): K falls into two blocks, its factor's
@@ -185,24 +203,22 @@ TEST(CouplingMultiplierSolver, TwoBodiesAreSolvedInTwoIndependentParts) {
   const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
   EXPECT_NE(woodbury.backend().find("in 2 independent parts"), std::string::npos) << woodbury.backend();
 
-  Matrix3 vd(np, 3), vc(nn, 3);
-  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.0003 * p;
-  for (int i = 0; i < nn; ++i) vc.row(i) << 0.01 * i, -0.02 * i, std::sin(i);
-  Matrix3 lambda[2], vd_w[2], vc_w[2], dd, dc, lambda_f, residual;
+  Matrix3 vd, vc;
+  mixed_velocities(np, nn, 0.0003, 0.01, vd, vc);
+  Projected w[2];
   for (int threads : {1, 2}) {
 #ifdef _OPENMP
     const test::OmpThreads scope(threads);
 #endif
-    vd_w[threads - 1] = vd, vc_w[threads - 1] = vc;
-    woodbury.project(vd_w[threads - 1], vc_w[threads - 1], dd, dc, lambda[threads - 1]);
+    w[threads - 1] = projected(woodbury, vd, vc);
   }
-  EXPECT_EQ(lambda[0], lambda[1]);
-  EXPECT_EQ(vd_w[0], vd_w[1]);
-  EXPECT_EQ(vc_w[0], vc_w[1]);
-  Matrix3 vd_f = vd, vc_f = vc;
-  factor.project(vd_f, vc_f, dd, dc, lambda_f);
-  EXPECT_LT((lambda[0] - lambda_f).norm(), 1e-10 * lambda_f.norm());
-  woodbury.residual(vd_w[0], vc_w[0], residual);
+  EXPECT_EQ(w[0].lambda, w[1].lambda);
+  EXPECT_EQ(w[0].vd, w[1].vd);
+  EXPECT_EQ(w[0].vc, w[1].vc);
+  const Matrix3 lambda_f = projected(factor, vd, vc).lambda;
+  EXPECT_LT((w[0].lambda - lambda_f).norm(), 1e-10 * lambda_f.norm());
+  Matrix3 residual;
+  woodbury.residual(w[0].vd, w[0].vc, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
 }
 
@@ -229,15 +245,13 @@ TEST(CouplingMultiplierSolver, SupernodesAreSolvedAsPetscSolvesTheSameSystem) {
   const MultiplierSolver woodbury(fine, md, mc, std::nullopt), petsc(general, md, mc, std::string());
   EXPECT_NE(woodbury.backend().find("the widest of all 8 columns"), std::string::npos) << woodbury.backend();
 
-  Matrix3 vd(np, 3), vc(nn, 3);
-  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.003 * p;
-  for (int i = 0; i < nn; ++i) vc.row(i) << 0.01 * i, -0.02 * i, std::sin(i);
-  Matrix3 vd_w = vd, vc_w = vc, vd_p = vd, vc_p = vc, dd, dc, lambda_w, lambda_p, residual;
-  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
-  petsc.project(vd_p, vc_p, dd, dc, lambda_p);
+  Matrix3 vd, vc;
+  mixed_velocities(np, nn, 0.003, 0.01, vd, vc);
+  const Projected w = projected(woodbury, vd, vc), p = projected(petsc, vd, vc);
   // Measured: 6.3e-16 and 2.9e-16 (round-off); the bounds a few hundred and a few ten times that.
-  EXPECT_LT((lambda_w - lambda_p).norm(), 1e-13 * lambda_p.norm());
-  woodbury.residual(vd_w, vc_w, residual);
+  EXPECT_LT((w.lambda - p.lambda).norm(), 1e-13 * p.lambda.norm());
+  Matrix3 residual;
+  woodbury.residual(w.vd, w.vc, residual);
   EXPECT_LT(residual.norm(), 1e-14 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
 }
 
@@ -258,9 +272,8 @@ TEST(CouplingMultiplierSolver, AHeldNodeNoRowReachesLeavesTheSystemsShared) {
     if (!woodbury) a.settings.mediator = b.settings.mediator = Mediator::coarse;  // the general factor
     const MultiplierSolver eight(a, md, mc, std::nullopt), nine(b, md, mc_wider, std::nullopt);
     EXPECT_EQ(nine.systems(), 2) << nine.backend();
-    Matrix3 vd(np, 3), vc8(nn, 3), vc9(nn + 1, 3);
-    for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
-    for (int i = 0; i < nn; ++i) vc8.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
+    Matrix3 vd, vc8, vc9(nn + 1, 3);
+    mixed_velocities(np, nn, 0.03, 0.1, vd, vc8);
     vc9.topRows(nn) = vc8;
     vc9.row(nn) << 1.0, 2.0, 3.0;
     Matrix3 vd8 = vd, vd9 = vd, dd, dc, lambda8, lambda9;
@@ -328,18 +341,15 @@ TEST(CouplingMultiplierSolver, AFreeComponentKeepsItsVelocitiesAndTheHeldOnesMee
   general.settings.mediator = Mediator::coarse;
   const MultiplierSolver woodbury(fine, md_s, mc_s, std::nullopt), factor(general, md_s, mc_s, std::nullopt);
   EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
-  Matrix3 vd(fine.num_particles(), 3), vc(fine.Gc.cols(), 3), dd, dc, lambda_w, lambda_f;
-  for (int p = 0; p < vd.rows(); ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
-  for (int i = 0; i < vc.rows(); ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
-  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc;
-  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
-  factor.project(vd_f, vc_f, dd, dc, lambda_f);
-  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
-  EXPECT_LT((vc_w - vc_f).norm(), 1e-10 * vc.norm());
+  Matrix3 vd, vc;
+  mixed_velocities(fine.num_particles(), fine.Gc.cols(), 0.03, 0.1, vd, vc);
+  const Projected low_rank = projected(woodbury, vd, vc), f = projected(factor, vd, vc);
+  EXPECT_LT((low_rank.lambda - f.lambda).norm(), 1e-10 * f.lambda.norm());
+  EXPECT_LT((low_rank.vc - f.vc).norm(), 1e-10 * vc.norm());
   for (std::size_t p = 0; p < ties.size(); ++p)
     for (int c = 0; c < 3; ++c) {
       if (ties[p][static_cast<std::size_t>(c)]) continue;
-      EXPECT_EQ(vd_w(static_cast<Eigen::Index>(p), c), vd(static_cast<Eigen::Index>(p), c)) << p << c;
+      EXPECT_EQ(low_rank.vd(static_cast<Eigen::Index>(p), c), vd(static_cast<Eigen::Index>(p), c)) << p << c;
     }
 }
 
@@ -358,16 +368,13 @@ TEST(CouplingMultiplierSolver, AnUntiedDrivenRowKeepsTheWoodburyForm) {
   general.settings.mediator = Mediator::coarse;
   const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
   EXPECT_EQ(woodbury.backend().rfind("diagonal + low rank (Woodbury)", 0), 0u) << woodbury.backend();
-  Matrix3 vd(np, 3), vc(nn, 3), dd, dc, lambda_w, lambda_f, residual;
-  for (int p = 0; p < np; ++p) vd.row(p) << std::sin(0.7 * p), std::cos(1.3 * p), 0.5 - 0.03 * p;
-  for (int i = 0; i < nn; ++i) vc.row(i) << 0.1 * i, -0.2 * i, std::sin(i);
-  Matrix3 vd_w = vd, vc_w = vc, vd_f = vd, vc_f = vc;
-  woodbury.project(vd_w, vc_w, dd, dc, lambda_w);
-  factor.project(vd_f, vc_f, dd, dc, lambda_f);
-  EXPECT_LT((lambda_w - lambda_f).norm(), 1e-10 * lambda_f.norm());
-  EXPECT_LT((vc_w - vc_f).norm(), 1e-10 * vc.norm());
-  EXPECT_EQ(lambda_w.row(driven), Eigen::RowVector3d::Zero().eval());
-  EXPECT_EQ(vd_w.row(driven), vd.row(driven));
-  woodbury.residual(vd_w, vc_w, residual);
+  Matrix3 vd, vc, residual;
+  mixed_velocities(np, nn, 0.03, 0.1, vd, vc);
+  const Projected w = projected(woodbury, vd, vc), f = projected(factor, vd, vc);
+  EXPECT_LT((w.lambda - f.lambda).norm(), 1e-10 * f.lambda.norm());
+  EXPECT_LT((w.vc - f.vc).norm(), 1e-10 * vc.norm());
+  EXPECT_EQ(w.lambda.row(driven), Eigen::RowVector3d::Zero().eval());
+  EXPECT_EQ(w.vd.row(driven), vd.row(driven));
+  woodbury.residual(w.vd, w.vc, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());
 }
