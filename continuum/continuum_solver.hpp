@@ -25,7 +25,7 @@
 //    surface rule (`surface_rule`).
 //  - Explicit central difference = velocity Verlet: kick(dt/2), drift(dt), compute_forces(),
 //    kick(dt/2) (`step`). The coupled step (docs/theory.md#coupled-step) calls the three parts itself.
-//    Stable for dt < critical_time_step() = 2 / omega_max of M^-1 K (power iteration).
+//    Stable for dt < critical_time_step() = 2 / omega_max of M^-1 K (Lanczos).
 //  - `solve_static` assembles K into a PETSc Mat distributed over PETSC_COMM_WORLD (each rank
 //    adds its share of the integration points; one rank when run without mpirun) and solves
 //    K u = f with KSP; the PETSc option string (e.g. "-ksp_type cg -pc_type gamg") overrides the
