@@ -150,13 +150,17 @@ void solve_columns(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, 
   const double* value = L.valuePtr();
   Row* y = reinterpret_cast<Row*>(scratch.data());
   for (int s = first; s < last; ++s) {
-    const int k = supernode_start[s + 1] - supernode_start[s];
-    with_supernode_size(k, [&](auto size) { forward_supernode<decltype(size)::value, width>(outer, inner, value, columns[supernode_start[s]], scratch.data()); });
+    const int j0 = columns[supernode_start[s]];
+    with_supernode_size(supernode_start[s + 1] - supernode_start[s], [&](auto size) {
+      forward_supernode<decltype(size)::value, width>(outer, inner, value, j0, scratch.data());
+    });
   }
   for (int q = supernode_start[first]; q < supernode_start[last]; ++q) y[columns[q]] /= D[columns[q]];
   for (int s = last - 1; s >= first; --s) {
-    const int k = supernode_start[s + 1] - supernode_start[s];
-    with_supernode_size(k, [&](auto size) { backward_supernode<decltype(size)::value, width>(outer, inner, value, columns[supernode_start[s]], scratch.data()); });
+    const int j0 = columns[supernode_start[s]];
+    with_supernode_size(supernode_start[s + 1] - supernode_start[s], [&](auto size) {
+      backward_supernode<decltype(size)::value, width>(outer, inner, value, j0, scratch.data());
+    });
   }
 }
 
