@@ -539,7 +539,7 @@ double ContinuumSolver::critical_time_step() const {
   constexpr int max_steps = 1000;
   std::vector<double> alpha, beta;  // T_k's diagonal and off-diagonal
   double estimate = 0.0, residual = INFINITY;
-  for (int k = 0; k < max_steps && k < static_cast<int>(n); ++k) {
+  for (int k = 0;; ++k) {  // ends at the last step at the latest (below)
     for (size_t d = 0; d < n; ++d) scaled[d] = q[d] * inv_sqrt_mass[d];
     stiffness().multiply(scaled, w);  // w = A q
     double a = 0.0;

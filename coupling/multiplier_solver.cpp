@@ -450,24 +450,22 @@ MultiplierSolver::ForestFactor MultiplierSolver::forest_of(std::unique_ptr<Facto
     return b == a + 1 && rows == outer[b + 1] - outer[b] + 1 && inner[outer[a]] == b &&
            std::equal(inner + outer[a] + 1, inner + outer[a + 1], inner + outer[b]);
   };
-  std::vector<int> supernode_of_position(static_cast<std::size_t>(n) + 1);
   for (int q = 0; q < n; ++q) {
     const auto z = static_cast<std::size_t>(q);
     if (q == 0 || !continues(f.columns[z - 1], f.columns[z]) || q - f.supernode_start.back() == max_supernode)
       f.supernode_start.push_back(q);
-    supernode_of_position[z] = static_cast<int>(f.supernode_start.size()) - 1;
   }
   f.supernode_start.push_back(n);
-  supernode_of_position[static_cast<std::size_t>(n)] = static_cast<int>(f.supernode_start.size()) - 1;
   // Whole trees, in order, into tasks of at least task_columns columns (the last may have fewer);
-  // a tree starts a supernode.
+  // a tree starts a supernode, found among the starts by its first column's position.
+  const auto supernode_at = [&](int position) {
+    return static_cast<int>(std::lower_bound(f.supernode_start.begin(), f.supernode_start.end(), position) -
+                            f.supernode_start.begin());
+  };
   f.task_start.push_back(0);
-  int task_first_column = 0;
   for (std::size_t t = 1; t < start.size(); ++t)
-    if (start[t] - task_first_column >= task_columns || t + 1 == start.size()) {
-      f.task_start.push_back(supernode_of_position[static_cast<std::size_t>(start[t])]);
-      task_first_column = start[t];
-    }
+    if (start[t] - f.supernode_start[static_cast<std::size_t>(f.task_start.back())] >= task_columns || t + 1 == start.size())
+      f.task_start.push_back(supernode_at(start[t]));
   f.D = factor->vectorD();
   f.factor = std::move(factor);
   return f;
