@@ -115,7 +115,7 @@ constexpr KeyDoc band_keys[] = {
     {"width", KeyType::number, "m", Range::positive(), "", "the overlap's width on each face, below half_thickness"},
     {"along", KeyType::choice, "", {}, "", "the band's direction", "x | y | z"},
     {"from", KeyType::number, "m", Range::any(), "", "where the band starts along it (the overlap also ramps there)"},
-    {"to", KeyType::number, "m", Range::any(), "", "where it ends (a free end: no overlap there)"},
+    {"to", KeyType::number, "m", Range::any(), "", "where it ends (the overlap ramps there too; past a body's end by width or more, a free end)"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -303,8 +303,6 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
     return coupling::OverlapZone::shells(shells, weighting);
   }
   if (overlap.has("band")) {
-    // The shell of the slab |x[axis] - center| <= half_thickness, from <= x[along] <= to: the DEM
-    // inside, the overlap of `width` on both faces and at `from`, across all of the third direction.
     CaseNode band = overlap.child("band");
     const int axis = band.choice("axis", axes)[0] - 'x', along = band.choice("along", axes)[0] - 'x';
     if (along == axis) band.fail("along", "must differ from axis");
@@ -312,16 +310,10 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
     const double width = band.number("width", Range::positive(), "m");
     if (!(width < half)) band.fail("width", "must be below half_thickness (the band needs a pure-DEM core)");
     const double from = band.number("from", Range::any(), "m"), to = band.number("to", Range::any(), "m");
-    if (!(to > from + width)) band.fail("to", "must lie beyond from + width");
+    if (!(to > from + 2.0 * width)) band.fail("to", "must lie beyond from + 2 width (the overlaps at both ends and a pure-DEM core)");
     band.finish();
     overlap.finish();
-    constexpr double everywhere = 1e3;  // m: the third direction's extent
-    Box inner{Vec3{-everywhere, -everywhere, -everywhere}, Vec3{everywhere, everywhere, everywhere}}, outer = inner;
-    outer.lower[axis] = center - half, outer.upper[axis] = center + half;
-    inner.lower[axis] = center - half + width, inner.upper[axis] = center + half - width;
-    outer.lower[along] = from, outer.upper[along] = to;
-    inner.lower[along] = from + width, inner.upper[along] = to;
-    return coupling::OverlapZone::shell(inner, outer, weighting);
+    return coupling::OverlapZone::band(axis, center, half, width, along, from, to, weighting);
   }
   const Region region = Region::read(overlap);
   if (const auto* box = std::get_if<Box>(&region.shape())) {

@@ -196,6 +196,22 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
                      weighting, shell_description(inner, outer));
 }
 
+OverlapZone OverlapZone::band(int axis, double center, double half_thickness, double width, int along, double from,
+                              double to, Weighting weighting) {
+  if (axis < 0 || axis > 2 || along < 0 || along > 2 || axis == along)
+    throw SettingError("overlap", "a band runs along an axis other than the one across it");
+  if (!(width > 0.0 && width < half_thickness))
+    throw SettingError("overlap", "a band's overlap width must lie in (0, half_thickness): the band needs a pure-DEM core");
+  if (!(to - from > 2.0 * width)) throw SettingError("overlap", "a band must be longer than its two end overlaps");
+  constexpr double everywhere = 1e3;  // m: the third direction's extent
+  Box inner{Vec3{-everywhere, -everywhere, -everywhere}, Vec3{everywhere, everywhere, everywhere}}, outer = inner;
+  outer.lower[axis] = center - half_thickness, outer.upper[axis] = center + half_thickness;
+  inner.lower[axis] = outer.lower[axis] + width, inner.upper[axis] = outer.upper[axis] - width;
+  outer.lower[along] = from, outer.upper[along] = to;
+  inner.lower[along] = from + width, inner.upper[along] = to - width;
+  return shell(inner, outer, weighting);
+}
+
 OverlapZone OverlapZone::shells(const std::vector<std::pair<Box, Box>>& inner_outer, Weighting weighting) {
   const int n = static_cast<int>(inner_outer.size());
   if (n < 1 || n > kMaxShells)

@@ -68,6 +68,13 @@ class OverlapZone {
   // s = max over axes and sides of the fractional distance from the inner face to the outer
   // face; a side where the two faces coincide does not ramp.
   static OverlapZone shell(const Box& inner, const Box& outer, Weighting weighting);
+  // A slab |x[axis] - center| <= half_thickness from x[along] = from to x[along] = to, across all
+  // of the third direction: the DEM inside, the overlap its outer `width` on both faces and at
+  // both ends (from, to), so that a band that ends inside a body is tied to it there too; a band
+  // that runs out of the body ends `width` or more beyond it. Needs axis != along, 0 < width <
+  // half_thickness and to - from > 2 width (a pure-DEM core); InputError otherwise.
+  static OverlapZone band(int axis, double center, double half_thickness, double width, int along, double from,
+                          double to, Weighting weighting);
   // The union of shells (inner, outer), at most kMaxShells: DEM inside any inner box, continuum
   // outside every outer one; s = the smallest of the shells' s. One shell is shell().
   static OverlapZone shells(const std::vector<std::pair<Box, Box>>& inner_outer, Weighting weighting);

@@ -68,6 +68,28 @@ TEST(CouplingOverlapZone, ShellAndCylinder) {
   EXPECT_FALSE(cyl.contains({1.5, 0, 1}));
 }
 
+// A band along x from 0 to 10, across z within 1 of z = 0, its overlap 0.25 wide: the weight ramps
+// on both faces and at both ends, and beyond `to` the DEM domain ends (a band that ends inside a
+// body is tied to it there, not left running on into it).
+TEST(CouplingOverlapZone, BandRampsOnItsFacesAndAtBothEnds) {
+  const OverlapZone band = OverlapZone::band(2, 0.0, 1.0, 0.25, 0, 0.0, 10.0, {});
+  EXPECT_DOUBLE_EQ(band.alpha_d({5, 0, 0}), 1.0);
+  EXPECT_DOUBLE_EQ(band.alpha_d({5, 70, 0.875}), 0.5);  // half way across the upper face's overlap, any y
+  EXPECT_DOUBLE_EQ(band.alpha_d({5, -3, -0.9375}), 0.25);
+  EXPECT_DOUBLE_EQ(band.alpha_d({0.125, 0, 0}), 0.5);  // the end at `from`
+  EXPECT_DOUBLE_EQ(band.alpha_d({9.875, 0, 0}), 0.5);  // and the end at `to`
+  EXPECT_DOUBLE_EQ(band.alpha_d({9.8125, 0, 0.9375}), 0.25);  // the corner: the larger ramp
+  EXPECT_TRUE(band.contains({9.9, 0, 0}));
+  for (const Vec3& x : {Vec3{10.5, 0, 0}, Vec3{-0.5, 0, 0}, Vec3{5, 0, 1.5}}) {
+    EXPECT_EQ(band.alpha_d(x), 0.0) << x[0] << " " << x[2];
+    EXPECT_FALSE(band.in_dem_domain(x)) << x[0] << " " << x[2];
+  }
+  EXPECT_TRUE(band.in_pure_dem_zone({9.7, 0, 0.7}));
+  EXPECT_THROW(OverlapZone::band(2, 0.0, 1.0, 1.0, 0, 0.0, 10.0, {}), InputError);  // no pure-DEM core across
+  EXPECT_THROW(OverlapZone::band(2, 0.0, 1.0, 0.25, 0, 0.0, 0.5, {}), InputError);  // none along
+  EXPECT_THROW(OverlapZone::band(0, 0.0, 1.0, 0.25, 0, 0.0, 10.0, {}), InputError);  // along its own axis
+}
+
 // A coupled DE's share of the overlap (coupling_operators.hpp): the part of its cell inside,
 // against the volumes of the clipped boxes worked out by hand.
 TEST(CouplingOverlapZone, CellVolumeInsideTheOverlap) {
