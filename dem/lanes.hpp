@@ -6,6 +6,7 @@
 // (bonds/beam_bond.cpp) and the drift (particles.cpp) pass every item through their lanes,
 // alone or with seven others, and their results are the same on any thread count.
 #pragma once
+#include <cmath>
 #include <cstddef>
 
 #if defined(__AVX512F__)
@@ -55,6 +56,17 @@ inline LaneVec rotate(const LaneQuat& q, const LaneVec& a) {
           a.z + q.w * t.z + v.x * t.y - v.y * t.x};
 }
 using LaneMask = decltype(Lanes{} < Lanes{});
+// The lanes' square roots, each correctly rounded (as std::sqrt).
+inline Lanes lane_sqrt(Lanes x) {
+#if defined(__AVX512F__)
+  static_assert(lanes == 8);
+  return _mm512_sqrt_pd(x);  // one instruction (a loop of std::sqrt stays scalar: errno)
+#else
+  Lanes r;
+  for (std::size_t l = 0; l < lanes; ++l) r[l] = std::sqrt(x[l]);
+  return r;
+#endif
+}
 // Eight consecutive doubles from p, at any alignment, to or from a vector: one load or store
 // (a memcpy goes through the stack in halves, which a whole-vector load then waits on).
 typedef Lanes UnalignedLanes __attribute__((aligned(alignof(double)), may_alias));

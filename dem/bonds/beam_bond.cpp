@@ -23,16 +23,6 @@ namespace {
 using namespace simd;
 static_assert(BeamBondSet::block == lanes);
 
-inline Lanes lane_sqrt(Lanes x) {
-#if defined(__AVX512F__)
-  static_assert(lanes == 8);
-  return _mm512_sqrt_pd(x);  // one instruction (a loop of std::sqrt stays scalar: errno)
-#else
-  Lanes r;
-  for (std::size_t l = 0; l < lanes; ++l) r[l] = std::sqrt(x[l]);
-  return r;
-#endif
-}
 // 1 / x and 1 / sqrt(x) without a division. A division's result comes some 20 cycles after its
 // operand, and the kernel's chain (length, axis, the two end rotations, the twist) waited on
 // four of them in turn; the AVX-512 estimates (relative error below 2^-14) take a few cycles,

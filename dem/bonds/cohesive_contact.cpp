@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "dem/bonds/cohesive_contact.hpp"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numbers>
 #include <stdexcept>
 
 #include "common/case_file.hpp"
 #include "common/quat.hpp"
+#include "dem/lanes.hpp"
 
 namespace arlequin::dem {
 
@@ -110,52 +114,102 @@ void CohesiveContactSet::finalize(std::size_t n_particles) {
 }
 
 CohesiveContactSet::Evaluation CohesiveContactSet::evaluate(std::size_t b, const ParticleSet& p) const {
-  const std::uint32_t i = first_[b], j = second_[b];
-  const Vec3 arm_i = rotate(p.orientation[i], offset_i_[b]), arm_j = rotate(p.orientation[j], offset_j_[b]);
-  const Vec3 d = p.position[j] - p.position[i];
-  const Vec3 n = d / norm(d);
-  const Vec3 u = (p.position[j] + arm_j) - (p.position[i] + arm_i);
-  const double un = dot(u, n);
-  const Vec3 us = u - n * un;
-  const double s2 = norm2(us);
-  const double opening = std::max(un, 0.0), closing = std::max(-un, 0.0);
-  const double lambda2 = opening * opening + s2;
-  const double lambda = std::sqrt(lambda2);
+  Evaluation e;
+  evaluate_block(b, 1, p, &e);
+  return e;
+}
+
+// Never inlined: one compiled copy serves the force pass and single links, so FMA contraction
+// cannot differ between them.
+[[gnu::noinline]] void CohesiveContactSet::evaluate_block(std::size_t first, std::size_t count, const ParticleSet& p,
+                                                          Evaluation* out) const {
+  using namespace simd;
+  assert(count >= 1 && count <= lanes);
+  // Lane l holds link first + l; lanes past count repeat the last link (not written out).
+  // Positions, orientations and contact offsets are loaded one vector each and transposed.
+  Quad xa[lanes], xb[lanes], qa[lanes], qb[lanes], oa[lanes], ob[lanes];
+  Lanes K, stored, section;
+  for (std::size_t l = 0; l < lanes; ++l) {
+    const std::size_t b = first + std::min(l, count - 1);
+    xa[l] = load_position(p.position[first_[b]]);
+    xb[l] = load_position(p.position[second_[b]]);
+    std::memcpy(&qa[l], &p.orientation[first_[b]], sizeof(Quad));
+    std::memcpy(&qb[l], &p.orientation[second_[b]], sizeof(Quad));
+    oa[l] = load_position(offset_i_[b]);
+    ob[l] = load_position(offset_j_[b]);
+    K[l] = stiffness_[b], stored[l] = damage_[b], section[l] = section_[b];
+  }
+  const auto vectors = [](const Quad(&v)[lanes]) {
+    const LaneQuat t = transpose(v);
+    return LaneVec{t.w, t.v.x, t.v.y};
+  };
+  const LaneVec xi = vectors(xa), xj = vectors(xb);
+  const LaneVec arm_i = rotate(transpose(qa), vectors(oa)), arm_j = rotate(transpose(qb), vectors(ob));
+  const LaneVec d = xj - xi;
+  const LaneVec n = d * (1.0 / lane_sqrt(dot(d, d)));
+  const LaneVec u = (xj + arm_j) - (xi + arm_i);
+  const Lanes un = dot(u, n);
+  const LaneVec us = u - n * un;
+  const Lanes s2 = dot(us, us), zero{};
+  const Lanes opening = un < zero ? zero : un, closing = -un < zero ? zero : -un;  // std::max(., 0)
+  const Lanes lambda2 = opening * opening + s2;
+  const Lanes lambda = lane_sqrt(lambda2);
 
   // Onset and failure openings along the present mode mix (docs/theory.md#cohesive-contact).
   const Parameters& q = parameters_;
   const double k = q.stiffness;
   const double dn0 = q.strength_normal / k, ds0 = q.strength_shear / k;
-  const double mix = lambda2 > 0.0 ? s2 / lambda2 : 0.0;  // B
-  const double lambda0 =
-      lambda2 > 0.0 ? dn0 * ds0 * std::sqrt(lambda2 / (ds0 * ds0 * opening * opening + dn0 * dn0 * s2)) : dn0;
-  const double stored = damage_[b];
-  double damage = stored, dissipation = 0.0;
-  const double K = stiffness_[b];
+  const LaneMask mixed = lambda2 > zero;
+  const Lanes mix = mixed ? s2 / lambda2 : zero;  // B
+  const Lanes lambda0 =
+      mixed ? dn0 * ds0 * lane_sqrt(lambda2 / (ds0 * ds0 * opening * opening + dn0 * dn0 * s2)) : zero + dn0;
+  Lanes damage = stored, dissipation = zero;
   // Below the onset opening the damage stays as it is and nothing is dissipated: the mixed-mode
   // toughness (a pow) and the failure opening are needed only beyond it, in the process zone.
-  if (lambda > lambda0) {
-    const double toughness = q.toughness_I + (q.toughness_II - q.toughness_I) * std::pow(mix, q.bk_exponent);
-    const double lambda_f = std::max(2.0 * toughness / (k * lambda0), lambda0 * (1.0 + 1e-12));
-    const double trial = lambda >= lambda_f ? 1.0 : lambda_f * (lambda - lambda0) / (lambda * (lambda_f - lambda0));
-    damage = std::max(stored, trial);
+  if (const LaneMask softening = lambda > lambda0; any_lane(softening)) {
+    Lanes share = zero;  // B^eta, on the softening lanes only
+    for (std::size_t l = 0; l < lanes; ++l)
+      if (softening[l]) share[l] = std::pow(mix[l], q.bk_exponent);
+    const Lanes toughness = q.toughness_I + (q.toughness_II - q.toughness_I) * share;
+    const Lanes failure = 2.0 * toughness / (k * lambda0), least = lambda0 * (1.0 + 1e-12);
+    const Lanes lambda_f = failure < least ? least : failure;  // std::max
+    const Lanes trial = lambda >= lambda_f ? zero + 1.0 : lambda_f * (lambda - lambda0) / (lambda * (lambda_f - lambda0));
+    damage = softening ? (stored < trial ? trial : stored) : stored;
     // Fraction of G_c S dissipated once the damage is d, along this mix.
-    const auto dissipated_fraction = [&](double dmg) {
-      const double reached = lambda0 * lambda_f / (lambda_f - dmg * (lambda_f - lambda0));
+    const auto dissipated_fraction = [&](Lanes dmg) {
+      const Lanes reached = lambda0 * lambda_f / (lambda_f - dmg * (lambda_f - lambda0));
       return (reached - lambda0) / (lambda_f - lambda0);
     };
-    if (damage > stored && K > 0.0)
-      dissipation = toughness * section_[b] * (dissipated_fraction(damage) - dissipated_fraction(stored));
+    const LaneMask dissipating = softening & (damage > stored) & (K > zero);
+    dissipation = dissipating ? toughness * section * (dissipated_fraction(damage) - dissipated_fraction(stored)) : zero;
   }
-  Evaluation e;
-  e.force_on_j = (us + n * opening) * (-K * (1.0 - damage)) + n * (K * closing);
-  e.torque_on_i = cross(arm_i, -e.force_on_j);
-  e.torque_on_j = cross(arm_j, e.force_on_j);
-  e.damage = damage;
-  e.mode_mix = mix;
-  e.elastic = 0.5 * K * ((1.0 - damage) * lambda2 + closing * closing);
-  e.dissipation = dissipation;
-  return e;
+  const LaneVec force_on_j = (us + n * opening) * (-K * (1.0 - damage)) + n * (K * closing);
+  const LaneVec torque_on_i = cross(arm_i, LaneVec{-force_on_j.x, -force_on_j.y, -force_on_j.z});
+  const LaneVec torque_on_j = cross(arm_j, force_on_j);
+  const Lanes elastic = 0.5 * K * ((1.0 - damage) * lambda2 + closing * closing);
+  for (std::size_t l = 0; l < count; ++l) {
+    Evaluation& e = out[l];
+    e.force_on_j = {force_on_j.x[l], force_on_j.y[l], force_on_j.z[l]};
+    e.torque_on_i = {torque_on_i.x[l], torque_on_i.y[l], torque_on_i.z[l]};
+    e.torque_on_j = {torque_on_j.x[l], torque_on_j.y[l], torque_on_j.z[l]};
+    e.damage = damage[l];
+    e.mode_mix = mix[l];
+    e.elastic = elastic[l];
+    e.dissipation = dissipation[l];
+  }
+}
+
+void CohesiveContactSet::accumulate_forces(ParticleSet& p, const ForceScan& scan) const {
+  const Records r = records(scan);
+  for_each_bond_block(colouring_, static_cast<long>(simd::lanes), [&](std::size_t first, std::size_t end) {
+    Evaluation e[simd::lanes];
+    evaluate_block(first, end - first, p, e);
+    for (std::size_t b = first; b < end; ++b) {
+      apply(b, e[b - first], p);
+      commit(b, e[b - first]);
+      if (r.any()) record_scan(b, e[b - first], p, scan, r);
+    }
+  });
 }
 
 void CohesiveContactSet::reorder(std::span<const std::uint32_t> order) {

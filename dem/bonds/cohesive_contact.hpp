@@ -71,6 +71,13 @@ class CohesiveContactSet final : public BondKernelSet<CohesiveContactSet> {
   // Scales the sections to the nominal area (if given), then colours as every bond set.
   void finalize(std::size_t n_particles) override;
   Evaluation evaluate(std::size_t b, const ParticleSet& p) const;
+  // Links first .. first + count - 1 (1 <= count <= 8) at once, one a lane (dem/lanes.hpp), into
+  // out[0 .. count). Every evaluation, alone (evaluate) or in the force pass's blocks, goes
+  // through this one kernel, so a link's result does not depend on the links it shares a block
+  // with.
+  void evaluate_block(std::size_t first, std::size_t count, const ParticleSet& p, Evaluation* out) const;
+  // The force pass in blocks of eight links of a colour (BondKernelSet's records and history).
+  void accumulate_forces(ParticleSet& p, const ForceScan& scan) const override;
   // The force pass keeps the damage (irreversible) and the dissipated energy.
   void commit(std::size_t b, const Evaluation& e) const {
     damage_[b] = e.damage;

@@ -7,6 +7,7 @@
 // rigid rotation of the pair, and a pre-cracked link that carries nothing.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -201,6 +202,59 @@ TEST_F(CohesivePair, APrecrackedLinkCarriesNoTension) {
   EXPECT_EQ(damage(), 1.0);
   EXPECT_EQ(norm(pull({0.5 * dnf, 0, 0})), 0.0);
   EXPECT_EQ(link->energy(p), 0.0);
+}
+
+// Twenty links, each between its own two DEs 2 m apart (no shared DE: one colour, so blocks of
+// eight hold every state side by side): opened below the onset, into softening and past failure,
+// sheared, mixed, compressed, pre-cracked, with turned DEs. A force pass evaluates them eight at
+// a time; each link's actions, damage, dissipation and energy are those of the same link
+// evaluated alone (count 1, the other lanes idle), to the bit: a block's lanes never mix.
+TEST(CohesiveBlocks, ALinkInABlockActsAsTheLinkAlone) {
+  constexpr int links = 20;
+  const std::array<Vec3, 6> openings = {Vec3{0.5 * dn0, 0, 0},  Vec3{3 * dn0, 0, 0},       Vec3{2 * dnf, 0, 0},
+                                        Vec3{0, 0, 3 * ds0},    Vec3{2 * dn0, 2 * ds0, 0}, Vec3{-0.5 * dn0, 0, 0}};
+  const auto build = [&](ParticleSet& p) {
+    CohesiveContactSet::Parameters q{sigma_n, sigma_s, G_I, G_II, k, 2.0, Region(Box{{0.5, 69, -1}, {1.5, 71, 1}}), 0.0};
+    auto set = std::make_unique<CohesiveContactSet>(q);  // the link at y = 70 m starts failed
+    for (int m = 0; m < links; ++m) {
+      p.add({0, 10.0 * m, 0}, 1.0, 1.0);
+      p.add({2, 10.0 * m, 0}, 1.0, 1.0);
+      set->add(2 * m, 2 * m + 1, p);
+    }
+    set->finalize(p.size());
+    for (int m = 0; m < links; ++m) {
+      p.position[2 * m + 1] += openings[m % openings.size()];
+      if (m % 3 == 1) p.orientation[2 * m] = from_rotation_vector({1e-5 * m, 0, -2e-6});
+    }
+    return set;
+  };
+  ParticleSet blocks, alone;
+  const auto in_blocks = build(blocks), single = build(alone);
+  ASSERT_EQ(in_blocks->colours(), 1u);
+  ForceScan scan = criterion_scan();
+  scan.energy = true;
+  blocks.clear_forces();
+  in_blocks->accumulate_forces(blocks, scan);
+  int elastic = 0, softening = 0, failed = 0, pushed = 0;
+  for (int m = 0; m < links; ++m) {
+    const auto e = single->evaluate(m, alone);
+    const std::uint32_t i = single->first()[m], j = single->second()[m];
+    EXPECT_EQ(blocks.force[j], e.force_on_j) << m;
+    EXPECT_EQ(blocks.force[i], -e.force_on_j) << m;
+    EXPECT_EQ(blocks.torque[i], e.torque_on_i) << m;
+    EXPECT_EQ(blocks.torque[j], e.torque_on_j) << m;
+    EXPECT_EQ(in_blocks->damage_values()[m], e.damage) << m;
+    EXPECT_EQ(in_blocks->dissipated_values()[m], e.dissipation) << m;
+    EXPECT_EQ(in_blocks->recorded_energies()[m], e.elastic) << m;
+    elastic += e.damage == 0.0;
+    softening += e.damage > 0.0 && e.damage < 1.0;
+    failed += e.damage == 1.0;
+    pushed += e.force_on_j.x > 0.0;
+  }
+  EXPECT_EQ(elastic, 7);  // the states the openings make, in every block
+  EXPECT_EQ(softening, 9);
+  EXPECT_EQ(failed, 4);
+  EXPECT_EQ(pushed, 3);
 }
 
 TEST(CohesiveParameters, AreRefusedWhenTheSofteningOpeningIsNotBeyondTheElasticOne) {
