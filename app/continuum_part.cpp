@@ -305,15 +305,16 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
   if (overlap.has("band")) {
     CaseNode band = overlap.child("band");
     const int axis = band.choice("axis", axes)[0] - 'x', along = band.choice("along", axes)[0] - 'x';
-    if (along == axis) band.fail("along", "must differ from axis");
     const double center = band.number("center", Range::any(), "m"), half = band.number("half_thickness", Range::positive(), "m");
     const double width = band.number("width", Range::positive(), "m");
-    if (!(width < half)) band.fail("width", "must be below half_thickness (the band needs a pure-DEM core)");
     const double from = band.number("from", Range::any(), "m"), to = band.number("to", Range::any(), "m");
-    if (!(to > from + 2.0 * width)) band.fail("to", "must lie beyond from + 2 width (the overlaps at both ends and a pure-DEM core)");
     band.finish();
     overlap.finish();
-    return coupling::OverlapZone::band(axis, center, half, width, along, from, to, weighting);
+    try {
+      return coupling::OverlapZone::band(axis, center, half, width, along, from, to, weighting);
+    } catch (const SettingError& e) {  // its checks of the values, each naming its key
+      band.fail(e.key(), e.message());
+    }
   }
   const Region region = Region::read(overlap);
   if (const auto* box = std::get_if<Box>(&region.shape())) {

@@ -199,10 +199,11 @@ OverlapZone OverlapZone::shell(const Box& inner, const Box& outer, Weighting wei
 OverlapZone OverlapZone::band(int axis, double center, double half_thickness, double width, int along, double from,
                               double to, Weighting weighting) {
   if (axis < 0 || axis > 2 || along < 0 || along > 2 || axis == along)
-    throw SettingError("overlap", "a band runs along an axis other than the one across it");
+    throw SettingError("along", "must differ from axis");
   if (!(width > 0.0 && width < half_thickness))
-    throw SettingError("overlap", "a band's overlap width must lie in (0, half_thickness): the band needs a pure-DEM core");
-  if (!(to - from > 2.0 * width)) throw SettingError("overlap", "a band must be longer than its two end overlaps");
+    throw SettingError("width", "must be below half_thickness (the band needs a pure-DEM core)");
+  if (!(to - from > 2.0 * width))
+    throw SettingError("to", "must lie beyond from + 2 width (the overlaps at both ends and a pure-DEM core)");
   constexpr double everywhere = 1e3;  // m: the third direction's extent
   Box inner{Vec3{-everywhere, -everywhere, -everywhere}, Vec3{everywhere, everywhere, everywhere}}, outer = inner;
   outer.lower[axis] = center - half_thickness, outer.upper[axis] = center + half_thickness;

@@ -72,7 +72,8 @@ class OverlapZone {
   // of the third direction: the DEM inside, the overlap its outer `width` on both faces and at
   // both ends (from, to), so that a band that ends inside a body is tied to it there too; a band
   // that runs out of the body ends `width` or more beyond it. Needs axis != along, 0 < width <
-  // half_thickness and to - from > 2 width (a pure-DEM core); InputError otherwise.
+  // half_thickness and to - from > 2 width (a pure-DEM core); a SettingError naming the key
+  // (along, width, to) otherwise.
   static OverlapZone band(int axis, double center, double half_thickness, double width, int along, double from,
                           double to, Weighting weighting);
   // The union of shells (inner, outer), at most kMaxShells: DEM inside any inner box, continuum

@@ -114,6 +114,12 @@ inline LaneQuat transpose(const Quad (&q)[lanes]) {
            __builtin_shufflevector(yz01, yz23, 1, 3, 5, 7, 9, 11, 13, 15)}};
 }
 
+// Eight vectors loaded as (x, y, z, 0) (load_position) as one LaneVec.
+inline LaneVec transpose_vectors(const Quad (&v)[lanes]) {
+  const LaneQuat t = transpose(v);
+  return {t.w, t.v.x, t.v.y};
+}
+
 // A position (x, y, z, 0) as one vector: a masked load, which reads nothing past z.
 inline Quad load_position(const Vec3& x) {
 #if defined(__AVX512F__)

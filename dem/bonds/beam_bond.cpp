@@ -177,8 +177,8 @@ BeamBondSet::Actions BeamBondSet::actions(std::size_t b, const ParticleSet& p) c
     std::memcpy(&qa[l], &orientation[first_de[l]], sizeof(Quad));
     std::memcpy(&qb[l], &orientation[second_de[l]], sizeof(Quad));
   }
-  const LaneQuat qi = transpose(qa), qj = transpose(qb), dq = transpose(da);
-  const LaneVec d{dq.w, dq.v.x, dq.v.y};
+  const LaneQuat qi = transpose(qa), qj = transpose(qb);
+  const LaneVec d = transpose_vectors(da);
   const auto load = [&](const std::vector<double>& data) {
     Lanes v;
     if (count == lanes) std::memcpy(&v, data.data() + first, sizeof v);

@@ -139,12 +139,8 @@ CohesiveContactSet::Evaluation CohesiveContactSet::evaluate(std::size_t b, const
     ob[l] = load_position(offset_j_[b]);
     K[l] = stiffness_[b], stored[l] = damage_[b], section[l] = section_[b];
   }
-  const auto vectors = [](const Quad(&v)[lanes]) {
-    const LaneQuat t = transpose(v);
-    return LaneVec{t.w, t.v.x, t.v.y};
-  };
-  const LaneVec xi = vectors(xa), xj = vectors(xb);
-  const LaneVec arm_i = rotate(transpose(qa), vectors(oa)), arm_j = rotate(transpose(qb), vectors(ob));
+  const LaneVec xi = transpose_vectors(xa), xj = transpose_vectors(xb);
+  const LaneVec arm_i = rotate(transpose(qa), transpose_vectors(oa)), arm_j = rotate(transpose(qb), transpose_vectors(ob));
   const LaneVec d = xj - xi;
   const LaneVec n = d * (1.0 / lane_sqrt(dot(d, d)));
   const LaneVec u = (xj + arm_j) - (xi + arm_i);
