@@ -39,6 +39,8 @@ constexpr KeyDoc mesh_keys[] = {
     {"file", KeyType::file, "", {}, "", "a gmsh .geo (meshed at load) or .msh, relative to the case"},
     {"size", KeyType::number, "m", Range::non_negative(), "0", "element size for a .geo; 0: the file's own"},
     {"order", KeyType::integer, "", Range::between(1, 2), "1", "element order: P1 or P2 tetrahedra"},
+    {"join", KeyType::section, "", {}, "(none)",
+     "a region (box, cylinder, sphere, half_space) where the mesh's coincident nodes become one: bodies meshed apart are one body there"},
 };
 constexpr KeyDoc material_keys[] = {
     {"model", KeyType::choice, "", {}, "isotropic", "elastic model", "isotropic | transversely_isotropic | orthotropic"},
@@ -245,6 +247,12 @@ ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_
   out.solver.mesh.path = mesh.existing_file("file").string();
   out.solver.mesh.size = mesh.number_or("size", 0.0, Range::non_negative(), "m");
   out.solver.mesh.order = int(mesh.integer_or("order", 1, Range::between(1, 2)));
+  if (mesh.has("join")) {
+    CaseNode join_node = mesh.child("join");
+    const Region join = Region::read(join_node);
+    out.solver.mesh.joined = [join](const Vec3& x) { return join.contains(x); };
+    out.solver.mesh.joined_name = join_node.where() + ": " + join.describe();
+  }
   mesh.finish();
   out.solver.materials.push_back({"", read_material(section.child("material"))});
   static constexpr std::string_view shapes[] = {"sibson", "laplace"};
@@ -541,6 +549,7 @@ class Part final : public ContinuumPart {
     counts["continuum_tetrahedra"] = solver_->mesh().num_tets();
     counts["continuum_order"] = solver_->mesh().order();
     if (solver_->mesh().tets_left_out() > 0) counts["continuum_tetrahedra_left_out"] = solver_->mesh().tets_left_out();
+    if (solver_->mesh().nodes_joined() > 0) counts["continuum_nodes_joined"] = solver_->mesh().nodes_joined();
   }
 
  private:

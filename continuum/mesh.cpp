@@ -19,6 +19,8 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <numeric>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -93,6 +95,28 @@ void refuse_if_gmsh_crashes_on(const std::string& path) {
                      "): a malformed or truncated .msh; write it again from gmsh");
 }
 
+// Renumbers the groups' nodes and tetrahedra (new_node / new_tet: -1 for one that is gone; nodes
+// may map onto one another) and drops a group with nothing left.
+void renumber_groups(const std::vector<int>& new_node, const std::vector<int>& new_tet, std::vector<PhysicalGroup>& groups) {
+  std::vector<PhysicalGroup> kept_groups;
+  for (PhysicalGroup& g : groups) {
+    std::vector<int> group_nodes, group_tets;
+    std::vector<std::array<int, 3>> triangles;
+    for (int n : g.nodes)
+      if (new_node[n] >= 0) group_nodes.push_back(new_node[n]);
+    for (int e : g.tets)
+      if (new_tet[e] >= 0) group_tets.push_back(new_tet[e]);
+    for (const auto& f : g.triangles)
+      if (new_node[f[0]] >= 0 && new_node[f[1]] >= 0 && new_node[f[2]] >= 0)
+        triangles.push_back({new_node[f[0]], new_node[f[1]], new_node[f[2]]});
+    std::sort(group_nodes.begin(), group_nodes.end());
+    group_nodes.erase(std::unique(group_nodes.begin(), group_nodes.end()), group_nodes.end());
+    if (group_nodes.empty() || (g.dim == 3 && group_tets.empty()) || (g.dim == 2 && triangles.empty())) continue;
+    kept_groups.push_back({g.name, g.dim, std::move(group_nodes), std::move(triangles), std::move(group_tets)});
+  }
+  groups = std::move(kept_groups);
+}
+
 // MeshSource::left_out on the raw arrays; returns the number of tetrahedra dropped.
 int leave_out(int npe, const std::function<bool(const std::array<Vec3, 4>&)>& left_out, std::vector<Vec3>& nodes,
               std::vector<int>& tets, std::vector<PhysicalGroup>& groups) {
@@ -114,25 +138,113 @@ int leave_out(int npe, const std::function<bool(const std::array<Vec3, 4>&)>& le
   }
   const int dropped = ntet - static_cast<int>(kept_tets.size()) / npe;
   if (dropped == 0) return 0;
-  std::vector<PhysicalGroup> kept_groups;
-  for (PhysicalGroup& g : groups) {
-    std::vector<int> group_nodes, group_tets;
-    std::vector<std::array<int, 3>> triangles;
-    for (int n : g.nodes)
-      if (new_node[n] >= 0) group_nodes.push_back(new_node[n]);
-    for (int e : g.tets)
-      if (new_tet[e] >= 0) group_tets.push_back(new_tet[e]);
-    for (const auto& f : g.triangles)
-      if (new_node[f[0]] >= 0 && new_node[f[1]] >= 0 && new_node[f[2]] >= 0)
-        triangles.push_back({new_node[f[0]], new_node[f[1]], new_node[f[2]]});
-    std::sort(group_nodes.begin(), group_nodes.end());
-    if (group_nodes.empty() || (g.dim == 3 && group_tets.empty()) || (g.dim == 2 && triangles.empty())) continue;
-    kept_groups.push_back({g.name, g.dim, std::move(group_nodes), std::move(triangles), std::move(group_tets)});
-  }
+  renumber_groups(new_node, new_tet, groups);
   nodes = std::move(kept_nodes);
   tets = std::move(kept_tets);
-  groups = std::move(kept_groups);
   return dropped;
+}
+
+// 1e-9 of the extent of the nodes' bounding box: the distance within which two nodes are one.
+double coincidence_tolerance(const std::vector<Vec3>& nodes) {
+  Vec3 lo = nodes.front(), hi = nodes.front();
+  for (const Vec3& x : nodes) {
+    lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+    hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+  }
+  return 1e-9 * norm(hi - lo);
+}
+
+// MeshSource::joined on the raw arrays: the nodes where it holds that lie within
+// coincidence_tolerance of one another become one; a quadratic tetrahedron's edge node only with
+// both of its edge's vertices (so that an element is joined along whole edges, and a join
+// starting between two node planes starts at the next vertex plane). Returns how many nodes
+// remain of such sets.
+int join_coincident_nodes(int npe, const std::function<bool(const Vec3&)>& joined, std::vector<Vec3>& nodes,
+                          std::vector<int>& tets, std::vector<PhysicalGroup>& groups) {
+  const double tol = coincidence_tolerance(nodes);
+  std::vector<char> in_region(nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n) in_region[n] = joined(nodes[n]);
+  std::vector<char> edge_node_apart(nodes.size(), 0);
+  for (std::size_t e = 0; npe == 10 && e < tets.size() / npe; ++e) {
+    const int* t = tets.data() + e * npe;
+    for (std::size_t k = 0; k < kTetEdges.size(); ++k)
+      if (!(in_region[t[kTetEdges[k][0]]] && in_region[t[kTetEdges[k][1]]])) edge_node_apart[t[4 + k]] = 1;
+  }
+  std::vector<int> candidates;
+  for (int n = 0; n < static_cast<int>(nodes.size()); ++n)
+    if (in_region[n] && !edge_node_apart[n]) candidates.push_back(n);
+  std::sort(candidates.begin(), candidates.end(), [&](int a, int b) { return nodes[a].x < nodes[b].x; });
+  // Each node's first coincident node along x (itself if none comes before it).
+  std::vector<int> first(nodes.size());
+  for (int n = 0; n < static_cast<int>(nodes.size()); ++n) first[n] = n;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const int a = candidates[i];
+    if (first[a] != a) continue;
+    for (std::size_t j = i + 1; j < candidates.size() && nodes[candidates[j]].x - nodes[a].x <= tol; ++j) {
+      const int b = candidates[j];
+      if (first[b] == b && norm(nodes[a] - nodes[b]) <= tol) first[b] = a;
+    }
+  }
+  std::vector<int> new_node(nodes.size(), -1);
+  std::vector<Vec3> kept_nodes;
+  std::vector<char> merged;
+  for (int n = 0; n < static_cast<int>(nodes.size()); ++n) {
+    if (first[n] != n) continue;
+    new_node[n] = static_cast<int>(kept_nodes.size());
+    kept_nodes.push_back(nodes[n]);
+    merged.push_back(0);
+  }
+  int sets = 0;
+  for (int n = 0; n < static_cast<int>(nodes.size()); ++n) {
+    if (first[n] == n) continue;
+    new_node[n] = new_node[first[n]];
+    sets += merged[new_node[n]] == 0;
+    merged[new_node[n]] = 1;
+  }
+  if (sets == 0) return 0;
+  for (int& t : tets) t = new_node[t];
+  std::vector<int> same_tet(tets.size() / npe);  // no tetrahedron changes
+  std::iota(same_tet.begin(), same_tet.end(), 0);
+  renumber_groups(new_node, same_tet, groups);
+  nodes = std::move(kept_nodes);
+  return sets;
+}
+
+// Where `joined` holds for all three vertices of two boundary triangles that lie in one plane,
+// face each other and overlap, two bodies touch there without sharing nodes: their surface meshes
+// differ. Returns a point of the first such pair, or nothing.
+std::optional<Vec3> unjoined_contact(const Mesh& mesh, const std::function<bool(const Vec3&)>& joined) {
+  struct Face {
+    Vec3 a, b, c, centroid, normal;
+  };
+  std::vector<Face> faces;
+  for (const auto& t : mesh.boundary_triangles()) {
+    const Vec3 &a = mesh.nodes()[t[0]], &b = mesh.nodes()[t[1]], &c = mesh.nodes()[t[2]];
+    if (!(joined(a) && joined(b) && joined(c))) continue;
+    const Vec3 n = cross(b - a, c - a);
+    faces.push_back({a, b, c, (a + b + c) / 3.0, n / norm(n)});
+  }
+  const double tol = coincidence_tolerance(mesh.nodes());
+  // Whether p, in the triangle's plane, lies inside it (its edges included, to the tolerance).
+  const auto inside = [tol](const Face& f, const Vec3& p) {
+    const Vec3* v[3] = {&f.a, &f.b, &f.c};
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 edge = *v[(k + 1) % 3] - *v[k];
+      if (dot(cross(edge, p - *v[k]), f.normal) < -tol * norm(edge)) return false;
+    }
+    return true;
+  };
+  // Two overlapping triangles have centroids closer than the longest edge: a sweep along x.
+  double longest = 0.0;
+  for (const Face& f : faces) longest = std::max({longest, norm(f.b - f.a), norm(f.c - f.b), norm(f.a - f.c)});
+  std::sort(faces.begin(), faces.end(), [](const Face& f, const Face& g) { return f.centroid.x < g.centroid.x; });
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (std::size_t j = i + 1; j < faces.size() && faces[j].centroid.x - faces[i].centroid.x <= longest; ++j) {
+      const Face &f = faces[i], &g = faces[j];
+      if (dot(f.normal, g.normal) > -1.0 + 1e-9 || std::abs(dot(f.normal, g.centroid - f.centroid)) > tol) continue;
+      if (inside(f, g.centroid) || inside(g, f.centroid)) return f.centroid;
+    }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -296,8 +408,20 @@ Mesh Mesh::load(const MeshSource& source) {
     dropped = leave_out(npe, source.left_out, nodes, tets, groups);
     if (tets.empty()) throw InputError(source.path + ": every tetrahedron lies in " + source.left_out_name);
   }
+  const int joined = source.joined ? join_coincident_nodes(npe, source.joined, nodes, tets, groups) : 0;
   Mesh mesh(order, std::move(nodes), std::move(tets), std::move(groups));
   mesh.tets_left_out_ = dropped;
+  mesh.nodes_joined_ = joined;
+  // Joined bodies share every node of the face between them, which is then inside the mesh. Two
+  // faces still touching there have different surface meshes, and would be joined at points only.
+  if (source.joined)
+    if (const std::optional<Vec3> x = unjoined_contact(mesh, source.joined)) {
+      std::ostringstream msg;
+      msg << source.path << ": two bodies touch at (" << x->x << ", " << x->y << ", " << x->z << "), in "
+          << source.joined_name << ", without nodes to join: their surface meshes differ there (joining needs the "
+          << "same surface mesh on both, e.g. transfinite)";
+      throw InputError(msg.str());
+    }
   return mesh;
 }
 

@@ -10,6 +10,13 @@
 //    vertices (an Arlequin coupling's pure-DEM zone: whether the tetrahedron lies in it, which for
 //    a convex zone is whether its vertices do), then the nodes only those used; physical groups
 //    keep what remains of them, and a group with nothing left is dropped.
+//  - `MeshSource::joined` (optional, a convex region) joins bodies meshed apart: nodes it holds
+//    for that coincide (within 1e-9 of the mesh's extent) become one node, after left_out (a P2
+//    edge node only if it holds for both of the edge's vertices: whole edges are joined). Two
+//    arms meshed as separate volumes become one body there (the uncracked part of a specimen).
+//    Every boundary triangle it joins on all three vertices must find its match on the other
+//    side (the same surface mesh on both bodies, e.g. transfinite): one that does not is an
+//    InputError, since the bodies would be held at points only.
 //  - Problems are InputError: unreadable file, no tetrahedra, inverted or flat tetrahedron,
 //    empty physical group, unknown group name (the message lists the known ones).
 #pragma once
@@ -28,6 +35,8 @@ struct MeshSource {
   int order = 1;      // 1 or 2, for .geo
   std::function<bool(const std::array<Vec3, 4>&)> left_out;  // optional, on a tetrahedron's vertices: see the contract
   std::string left_out_name = "the left-out region";  // for the error when it holds everything
+  std::function<bool(const Vec3&)> joined{};  // optional, on a node's position: see the contract
+  std::string joined_name = "the joined region";  // for the error when the bodies' faces differ there
 };
 
 // Edge k of a tetrahedron joins vertices kTetEdges[k]; node 4+k of a P2 tetrahedron sits on it.
@@ -65,6 +74,7 @@ class Mesh {
   // Triangles (vertex triples) on the outer boundary: faces owned by one tetrahedron only.
   std::vector<std::array<int, 3>> boundary_triangles() const;
   int tets_left_out() const { return tets_left_out_; }  // by MeshSource::left_out
+  int nodes_joined() const { return nodes_joined_; }      // by MeshSource::joined: nodes that were two or more
 
  private:
   int order_;
@@ -72,6 +82,7 @@ class Mesh {
   std::vector<int> tets_;
   std::vector<PhysicalGroup> groups_;
   int tets_left_out_ = 0;
+  int nodes_joined_ = 0;
 };
 
 }  // namespace arlequin::continuum

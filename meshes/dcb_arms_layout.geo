@@ -6,14 +6,23 @@
 // pre-crack they are free of each other, beyond it only the DEM band (the cohesive interface)
 // joins them. Each arm is three layers of 0.5 mm glued together, so that the load strips of the
 // end face (x = 0, z in [0.5, 1] mm and [2, 2.5] mm, where cases/dcb drives its load-line DEs)
-// are physical surfaces: "load_bottom", "load_top". Structured (transfinite).
+// are physical surfaces: "load_bottom", "load_top". Structured (transfinite), so that both arms
+// have the same nodes on the mid-plane: a case may join them there (continuum.mesh.join). With
+// `fused = 1` set first, the six layers are one body (dcb_arms_coarse_fused.geo, for tests).
 SetFactory("OpenCASCADE");
 L = 45e-3; b = 6e-3; h = 1.5e-3; t = 0.5e-3;
 For k In {0:5}
   Box(k + 1) = {0, 0, k * t, L, b, t};
 EndFor
-BooleanFragments{ Volume{1, 2, 3}; Delete; }{}
-BooleanFragments{ Volume{4, 5, 6}; Delete; }{}
+If (!Exists(fused))
+  fused = 0;
+EndIf
+If (fused)
+  BooleanFragments{ Volume{1, 2, 3, 4, 5, 6}; Delete; }{}
+Else
+  BooleanFragments{ Volume{1, 2, 3}; Delete; }{}
+  BooleanFragments{ Volume{4, 5, 6}; Delete; }{}
+EndIf
 e = 1e-7;
 Transfinite Curve {Curve In BoundingBox{-e, -e, -e, L + e, e, 2 * h + e}} = nx;   // along x (y = 0 face)
 Transfinite Curve {Curve In BoundingBox{-e, b - e, -e, L + e, b + e, 2 * h + e}} = nx;

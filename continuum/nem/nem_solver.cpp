@@ -159,6 +159,47 @@ int find_or_add_plane(std::vector<Plane>& planes, const Face& t, const std::vect
   return static_cast<int>(planes.size()) - 1;
 }
 
+// The planes that cut a non-convex body into convex pieces: those of its boundary faces
+// (`planes`) and, where a plane holds both boundary faces of the body and faces inside it (two
+// bodies meshed apart and joined over part of their common face, continuum/mesh.hpp: a slit
+// that ends inside the body), the plane through each edge where the two kinds meet,
+// perpendicular to that plane. Without these the pieces on either side of the slit's plane
+// would meet on part of a face only.
+std::vector<Plane> planes_with_slit_ends(const Mesh& mesh, const std::map<std::array<int, 3>, std::vector<std::pair<int, std::array<int, 3>>>>& faces,
+                                         const std::vector<int>& body_tets, const std::vector<Plane>& planes, double tol) {
+  const std::vector<Vec3>& X = mesh.nodes();
+  std::vector<char> in_body(mesh.num_tets(), 0);
+  for (int e : body_tets) in_body[e] = 1;
+  const auto on_plane = [&](const std::array<int, 3>& f, const Plane& p) {
+    return std::all_of(f.begin(), f.end(), [&](int v) { return std::abs(dot(p.n, X[v]) - p.d) <= tol; });
+  };
+  std::vector<Plane> cuts = planes;
+  for (const Plane& p : planes) {
+    // The edges of the body's faces on p, counted +1 for a boundary face's, +2 for an inner face's.
+    std::map<std::pair<int, int>, int> edge_kinds;
+    for (const auto& [key, holders] : faces) {
+      if (!in_body[holders[0].first] || !on_plane(key, p)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int a = key[k], c = key[(k + 1) % 3];
+        int& kinds = edge_kinds[{std::min(a, c), std::max(a, c)}];
+        kinds |= holders.size() == 1 ? 1 : 2;
+      }
+    }
+    for (const auto& [edge, kinds] : edge_kinds) {
+      if (kinds != 3) continue;
+      const Vec3 a = X[edge.first], b = X[edge.second];
+      Plane cut;
+      cut.n = normalized(cross(p.n, b - a));
+      cut.d = dot(cut.n, a);
+      const bool known = std::any_of(cuts.begin(), cuts.end(), [&](const Plane& q) {
+        return std::abs(std::abs(dot(q.n, cut.n)) - 1.0) < 1e-9 && std::abs(dot(q.n, a) - q.d) < tol;
+      });
+      if (!known) cuts.push_back(std::move(cut));
+    }
+  }
+  return cuts;
+}
+
 // The convex pieces of the mesh (see Body): its bodies (tetrahedra joined through shared nodes,
 // union-find), by their first node; a body that is not convex is cut by the planes of its
 // boundary faces, each tetrahedron going to the piece on its side of every one of them (a cell
@@ -214,13 +255,14 @@ std::vector<Body> mesh_pieces(const Mesh& mesh, double tol) {
       pieces.emplace_back().tets = body_tets[b];
       continue;
     }
+    const std::vector<Plane> cuts = planes_with_slit_ends(mesh, faces, body_tets[b], planes, tol);
     std::map<std::vector<char>, int> piece_of_side;  // which side of each plane -> piece
     for (int e : body_tets[b]) {
-      std::vector<char> side(planes.size());
-      for (std::size_t k = 0; k < planes.size(); ++k) {
+      std::vector<char> side(cuts.size());
+      for (std::size_t k = 0; k < cuts.size(); ++k) {
         double lo = 1e300, hi = -1e300;
         for (int a = 0; a < 4; ++a) {
-          const double s = dot(planes[k].n, X[mesh.tet(e)[a]]) - planes[k].d;
+          const double s = dot(cuts[k].n, X[mesh.tet(e)[a]]) - cuts[k].d;
           lo = std::min(lo, s), hi = std::max(hi, s);
         }
         if (lo < -tol && hi > tol)
