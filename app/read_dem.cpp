@@ -17,6 +17,7 @@
 #include "common/region.hpp"
 #include "common/schema.hpp"
 #include "dem/bonds/bond_set.hpp"
+#include "dem/bonds/cohesive_contact.hpp"
 #include "dem/contacts/contact_law.hpp"
 #include "dem/sample_file.hpp"
 #include "dem/samples.hpp"
@@ -367,6 +368,24 @@ void read_bonds(CaseNode bond, dem::DemModel& model, double default_tolerance) {
     bond.fail("tolerance", "no pair of DEs is close enough to bond; raise the tolerance or remove 'bond'");
 }
 
+// A cohesive interface's `area` is the nominal area its links' sections add up to (d26). Given
+// for a whole interface where only part of it holds DEs (a coupled DEM band), it would make
+// every link that many times too stiff and too strong, silently: refused when it is not within
+// 10 % of the area the links cover (CohesiveContactSet::covered_area, which the cases' `area`
+// exceeds by 0.9 to 2.7 %, docs/decisions.md#d55).
+void check_interface_area(const dem::BondSet& interface, const dem::ParticleSet& p, CaseNode& bond) {
+  const auto* cohesive = dynamic_cast<const dem::CohesiveContactSet*>(&interface);
+  if (!cohesive || !(cohesive->parameters().area > 0.0)) return;
+  const double covered = cohesive->covered_area(p), ratio = cohesive->parameters().area / covered;
+  if (!(covered > 0.0) || std::abs(std::log(ratio)) <= std::log(1.1)) return;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "%.4g m^2 is %.3g times the %.4g m^2 its %zu links cover (their contact points' hull, widened by half "
+                "their spacing): expected the nominal area of the interface where there are DEs (a DEM band's share of it)",
+                cohesive->parameters().area, ratio, covered, interface.size());
+  bond.fail("area", text);
+}
+
 // Several materials (e.g. a fibre cylinder in a matrix cube): each DE takes the first material
 // whose region holds it, or the one material without a region; it gets that material's density
 // and a group named after it. A bond between two DEs of one material uses that material's bond
@@ -450,6 +469,7 @@ std::vector<std::string> read_materials(CaseNode dem_node, dem::DemModel& model,
     if (std::count(broken.begin(), broken.end(), std::uint8_t{1}) == std::ptrdiff_t(broken.size()))
       interface_bond->fail("precrack", "the pre-crack holds every one of the interface's " + std::to_string(broken.size()) +
                                            " links: it is as long as the specimen, nothing is left to crack");
+    check_interface_area(*interface, p, *interface_bond);
   }
   std::vector<std::string> names;
   for (std::size_t m = 0; m < list.size(); ++m) {

@@ -25,7 +25,7 @@ constexpr KeyDoc cohesive_keys[] = {
     {"stiffness", KeyType::number, "Pa/m", Range::positive(), "", "traction per opening before damage, both directions"},
     {"bk_exponent", KeyType::number, "1", Range::positive(), "2", "Benzeggagh-Kenane exponent eta of the mixed-mode toughness"},
     {"precrack", KeyType::section, "", {}, "(none)", "a region: links whose mid-point lies in it start failed"},
-    {"area", KeyType::number, "m^2", Range::positive(), "(none)", "nominal interface area the links' sections are scaled to add up to"},
+    {"area", KeyType::number, "m^2", Range::positive(), "(none)", "nominal interface area the links' sections are scaled to add up to: where there are DEs, within 10 % of what the links cover"},
 };
 std::span<const KeyDoc> CohesiveContactSet::keys() { return cohesive_keys; }
 
@@ -98,6 +98,63 @@ void CohesiveContactSet::add(std::uint32_t i, std::uint32_t j, const ParticleSet
     damage_.back() = 1.0;
     stiffness_.back() = 0.0;
   }
+}
+
+namespace {
+
+struct Point2 {
+  double x, y;
+};
+double turn(const Point2& o, const Point2& a, const Point2& b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); }
+
+// Area and perimeter of the convex hull of `points` (Andrew's monotone chain; reorders them).
+std::pair<double, double> hull_area_and_perimeter(std::vector<Point2>& points) {
+  std::sort(points.begin(), points.end(), [](const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+  std::vector<Point2> hull(2 * points.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {  // lower chain
+    while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);  // the last point is the first
+  double area = 0.0, perimeter = 0.0;
+  for (std::size_t m = 0; m < hull.size(); ++m) {
+    const Point2 &a = hull[m], &b = hull[(m + 1) % hull.size()];
+    area += 0.5 * (a.x * b.y - b.x * a.y);
+    perimeter += std::hypot(b.x - a.x, b.y - a.y);
+  }
+  return {area, perimeter};
+}
+
+}  // namespace
+
+double CohesiveContactSet::covered_area(const ParticleSet& p) const {
+  const std::size_t n = size();
+  if (n < 3) return 0.0;
+  Vec3 normal{};
+  for (std::size_t b = 0; b < n; ++b) {
+    const Vec3 d = p.position[second()[b]] - p.position[first()[b]];
+    normal += dot(d, normal) < 0.0 ? -1.0 * (d / norm(d)) : d / norm(d);
+  }
+  normal = normal / norm(normal);
+  const Vec3 e1 = normalized(cross(normal, std::abs(normal.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+  const Vec3 e2 = cross(normal, e1);
+  std::vector<Point2> points(n);
+  double lowest = INFINITY, highest = -INFINITY;
+  for (std::size_t b = 0; b < n; ++b) {
+    const Vec3 c = p.position[first()[b]] + offset_i_[b];
+    points[b] = {dot(c, e1), dot(c, e2)};
+    lowest = std::min(lowest, dot(c, normal));
+    highest = std::max(highest, dot(c, normal));
+  }
+  const auto [area, perimeter] = hull_area_and_perimeter(points);
+  if (!(area > 0.0) || highest - lowest > 0.1 * std::sqrt(area)) return 0.0;
+  const double delta = 0.5 * std::sqrt(area / static_cast<double>(n));
+  return area + perimeter * delta + std::numbers::pi * delta * delta;
 }
 
 void CohesiveContactSet::finalize(std::size_t n_particles) {

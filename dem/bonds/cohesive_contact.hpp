@@ -108,6 +108,14 @@ class CohesiveContactSet final : public BondKernelSet<CohesiveContactSet> {
 
   const Parameters& parameters() const { return parameters_; }
   double section(std::size_t b) const { return section_[b]; }  // S of link b, m^2
+  // The area of the interface the links cover, m^2, from their contact points as built (DEs in
+  // their reference places): the convex hull of the points in the plane normal to the links'
+  // mean direction, widened by half the links' spacing delta = sqrt(hull / links) / 2 all round
+  // (A + P delta + pi delta^2). What `area` should be, to a few per cent on a plane interface
+  // (the outermost contact points lie about a radius inside its edges); 0 when the points do
+  // not lie in one plane (spread along the normal over a tenth of the hull's size) or are
+  // fewer than three.
+  double covered_area(const ParticleSet& p) const;
 
  private:
   void save_law_state(StateArchive& archive, const std::string& prefix) const override;

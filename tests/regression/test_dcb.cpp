@@ -238,6 +238,23 @@ test::CliResult run_reduced_coupled(const std::filesystem::path& out, const std:
   return test::run_arlequin("run " + coupled_case + reduced_coupled + " " + overrides + " --out " + out.string());
 }
 
+// A DEM band cut short (12 to 27 mm) with the case's `area` (its 12 to 45 mm band's) would make
+// every cohesive link 2.2 times too stiff and too strong: refused, naming the key and what the
+// links cover; with the band's share (15 x 6 mm) it is accepted (docs/decisions.md#d55).
+TEST(Dcb, AnInterfaceAreaBeyondWhatItsLinksCoverIsRefused) {
+#ifndef ARLEQUIN_WITH_CONTINUUM
+  GTEST_SKIP() << "built without the continuum";
+#endif
+  const auto out = test::scratch_dir("dcb_coupled_cut_band");
+  const std::string cut = "run " + coupled_case + reduced_coupled + " --set coupling.overlap.band.to=0.027 --steps 1 --out " + out.string();
+  const auto refused = test::run_arlequin(cut);
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("dem.interface.bond.area: 0.000198 m^2 is 2.2"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("times the 8."), std::string::npos) << refused.output;
+  const auto accepted = test::run_arlequin(cut + " --set dem.interface.bond.area=0.9e-4");
+  EXPECT_EQ(accepted.exit_code, 0) << accepted.output;
+}
+
 TEST(Dcb, ReducedCoupledDcbBalancesEnergyAndKeepsItsDamageInTheBand) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";

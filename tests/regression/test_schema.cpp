@@ -105,7 +105,7 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
             {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
              "continuum.mesh.file=../../meshes/dcb_arms_coarse.geo", "coupling.overlap.band.half_thickness=1.0e-3",
              "coupling.overlap.band.width=5.0e-4", "coupling.overlap.band.to=0.027",
-             "continuum.mesh.join={box: [[0.0275, -1, -1], [1, 1, 1]]}"},
+             "dem.interface.bond.area=0.9e-4", "continuum.mesh.join={box: [[0.0275, -1, -1], [1, 1, 1]]}"},
             dir_);
 
   read_case(cases + "fabric_impact/reduced.yaml",
