@@ -165,17 +165,18 @@ int find_or_add_plane(std::vector<Plane>& planes, const Face& t, const std::vect
 // that ends inside the body), the plane through each edge where the two kinds meet,
 // perpendicular to that plane. Without these the pieces on either side of the slit's plane
 // would meet on part of a face only.
-std::vector<Plane> planes_with_slit_ends(const Mesh& mesh, const std::map<std::array<int, 3>, std::vector<std::pair<int, std::array<int, 3>>>>& faces,
+std::vector<Plane> planes_with_slit_ends(const Mesh& mesh, const std::map<Face, std::vector<std::pair<int, Face>>>& faces,
                                          const std::vector<int>& body_tets, const std::vector<Plane>& planes, double tol) {
   const std::vector<Vec3>& X = mesh.nodes();
   std::vector<char> in_body(mesh.num_tets(), 0);
   for (int e : body_tets) in_body[e] = 1;
-  const auto on_plane = [&](const std::array<int, 3>& f, const Plane& p) {
+  const auto on_plane = [&](const Face& f, const Plane& p) {
     return std::all_of(f.begin(), f.end(), [&](int v) { return std::abs(dot(p.n, X[v]) - p.d) <= tol; });
   };
   std::vector<Plane> cuts = planes;
   for (const Plane& p : planes) {
-    // The edges of the body's faces on p, counted +1 for a boundary face's, +2 for an inner face's.
+    // The edges of the body's faces on p, each marked 1 if a boundary face has it, 2 if an inner
+    // face has it: 3 where the slit ends.
     std::map<std::pair<int, int>, int> edge_kinds;
     for (const auto& [key, holders] : faces) {
       if (!in_body[holders[0].first] || !on_plane(key, p)) continue;
@@ -202,10 +203,11 @@ std::vector<Plane> planes_with_slit_ends(const Mesh& mesh, const std::map<std::a
 
 // The convex pieces of the mesh (see Body): its bodies (tetrahedra joined through shared nodes,
 // union-find), by their first node; a body that is not convex is cut by the planes of its
-// boundary faces, each tetrahedron going to the piece on its side of every one of them (a cell
-// of the planes' arrangement, convex; two cells meet on a whole face of each). Each piece's
-// planes are those of its boundary faces in the order of their sorted vertex triples (as
-// Mesh::boundary_triangles), each with the piece across it.
+// boundary faces (and across the ends of a slit, planes_with_slit_ends), each tetrahedron going
+// to the piece on its side of every one of them (a cell of the planes' arrangement, convex; two
+// cells meet on a whole face of each). Each piece's planes are those of its boundary faces in
+// the order of their sorted vertex triples (as Mesh::boundary_triangles), each with the piece
+// across it.
 std::vector<Body> mesh_pieces(const Mesh& mesh, double tol) {
   const std::vector<Vec3>& X = mesh.nodes();
   const int n = mesh.num_nodes(), tets = mesh.num_tets();
