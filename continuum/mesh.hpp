@@ -14,9 +14,9 @@
 //    for that coincide (within 1e-9 of the mesh's extent) become one node, after left_out (a P2
 //    edge node only if it holds for both of the edge's vertices: whole edges are joined). Two
 //    arms meshed as separate volumes become one body there (the uncracked part of a specimen).
-//    Every boundary triangle it joins on all three vertices must find its match on the other
-//    side (the same surface mesh on both bodies, e.g. transfinite): one that does not is an
-//    InputError, since the bodies would be held at points only.
+//    Two bodies whose boundary faces still touch inside it (in one plane, facing each other,
+//    overlapping) have different surface meshes there and would be held at points only: an
+//    InputError (joining needs the same surface mesh on both, e.g. transfinite).
 //  - Problems are InputError: unreadable file, no tetrahedra, inverted or flat tetrahedron,
 //    empty physical group, unknown group name (the message lists the known ones).
 #pragma once

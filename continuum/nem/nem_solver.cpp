@@ -147,9 +147,8 @@ std::pair<Vec3, double> plane_of(const Face& t, const std::vector<Vec3>& X) {
   return {n, dot(n, X[t[0]])};
 }
 
-// Adds the plane of triangle t to `planes` unless one there is the same (within tol).
-int find_or_add_plane(std::vector<Plane>& planes, const Face& t, const std::vector<Vec3>& X, double tol) {
-  const auto [n, d] = plane_of(t, X);
+// Adds the plane n.x = d (n unit) to `planes` unless one there is the same (within tol).
+int find_or_add_plane(std::vector<Plane>& planes, const Vec3& n, double d, double tol) {
   for (std::size_t k = 0; k < planes.size(); ++k)
     if (norm(planes[k].n - n) < 1e-9 && std::abs(planes[k].d - d) < tol) return static_cast<int>(k);
   Plane p;
@@ -157,6 +156,11 @@ int find_or_add_plane(std::vector<Plane>& planes, const Face& t, const std::vect
   p.d = d;
   planes.push_back(std::move(p));
   return static_cast<int>(planes.size()) - 1;
+}
+// The same for the plane of triangle t of nodes X, oriented as plane_of.
+int find_or_add_plane(std::vector<Plane>& planes, const Face& t, const std::vector<Vec3>& X, double tol) {
+  const auto [n, d] = plane_of(t, X);
+  return find_or_add_plane(planes, n, d, tol);
 }
 
 // The planes that cut a non-convex body into convex pieces: those of its boundary faces
@@ -188,14 +192,13 @@ std::vector<Plane> planes_with_slit_ends(const Mesh& mesh, const std::map<Face, 
     }
     for (const auto& [edge, kinds] : edge_kinds) {
       if (kinds != 3) continue;
-      const Vec3 a = X[edge.first], b = X[edge.second];
-      Plane cut;
-      cut.n = normalized(cross(p.n, b - a));
-      cut.d = dot(cut.n, a);
-      const bool known = std::any_of(cuts.begin(), cuts.end(), [&](const Plane& q) {
-        return std::abs(std::abs(dot(q.n, cut.n)) - 1.0) < 1e-9 && std::abs(dot(q.n, a) - q.d) < tol;
-      });
-      if (!known) cuts.push_back(std::move(cut));
+      // A cut's side does not matter: its normal's largest component is made positive, so that
+      // the slit's two faces (opposite normals) give it once.
+      const Vec3 a = X[edge.first];
+      Vec3 n = normalized(cross(p.n, X[edge.second] - a));
+      const int largest = std::abs(n.x) >= std::max(std::abs(n.y), std::abs(n.z)) ? 0 : std::abs(n.y) >= std::abs(n.z) ? 1 : 2;
+      if (n[largest] < 0.0) n = -1.0 * n;
+      find_or_add_plane(cuts, n, dot(n, a), tol);
     }
   }
   return cuts;

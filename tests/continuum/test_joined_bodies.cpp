@@ -159,7 +159,9 @@ TEST(ContinuumJoin, ASlitEndingInsideTheBodyIsCutIntoPiecesThatMeetOnWholeFaces)
       sum += it.value();
       x += it.value() * nem->nodes()[it.col()];
       const double z = nem->nodes()[it.col()].z;
-      if (slit) EXPECT_TRUE(upper ? z >= kArmThickness - 1e-12 : z <= kArmThickness + 1e-12) << "point " << p << " takes node " << it.col();
+      if (slit) {
+        EXPECT_TRUE(upper ? z >= kArmThickness - 1e-12 : z <= kArmThickness + 1e-12) << "point " << p << " takes node " << it.col();
+      }
     }
     worst_sum = std::max(worst_sum, std::abs(sum - 1.0));
     worst_position = std::max(worst_position, norm(x - points[p]));
