@@ -372,7 +372,7 @@ void read_bonds(CaseNode bond, dem::DemModel& model, double default_tolerance) {
 // for a whole interface where only part of it holds DEs (a coupled DEM band), it would make
 // every link that many times too stiff and too strong, silently: refused when it is not within
 // 10 % of the area the links cover (CohesiveContactSet::covered_area, which the cases' `area`
-// exceeds by 0.9 to 2.7 %, docs/decisions.md#d55).
+// exceeds by 0.9 to 2.6 %, docs/decisions.md#d55).
 void check_interface_area(const dem::BondSet& interface, const dem::ParticleSet& p, CaseNode& bond) {
   const auto* cohesive = dynamic_cast<const dem::CohesiveContactSet*>(&interface);
   if (!cohesive || !(cohesive->parameters().area > 0.0)) return;
