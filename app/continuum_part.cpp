@@ -118,6 +118,13 @@ constexpr KeyDoc band_keys[] = {
     {"along", KeyType::choice, "", {}, "", "the band's direction", "x | y | z"},
     {"from", KeyType::number, "m", Range::any(), "", "where the band starts along it (the overlap also ramps there)"},
     {"to", KeyType::number, "m", Range::any(), "", "where it ends (the overlap ramps there too; past a body's end by width or more, a free end)"},
+    {"follow", KeyType::section, "", {}, "(none)", "the band moves along to keep the DEM interface's crack inside it (docs/theory.md#moving-zone)"},
+};
+constexpr KeyDoc follow_keys[] = {
+    {"margin", KeyType::number, "m", Range::positive(), "", "the band moves when the interface's damage front comes within this of its to"},
+    {"ahead", KeyType::number, "m", Range::positive(), "", "its new to: this beyond the damage front (at most until; more than margin)"},
+    {"behind", KeyType::number, "m", Range::positive(), "(from stays)", "its new from: this behind the crack tip (never back; moving it disturbs the run, docs/decisions.md#d56)"},
+    {"until", KeyType::number, "m", Range::any(), "", "the furthest to: the band's to with the whole interface in it"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -130,6 +137,7 @@ constexpr SchemaSection continuum_sections[] = {
     {"coupling.overlap.shell", "a shell overlap", shell_keys},
     {"coupling.overlap.shells[]", "a shell of a union of shells", shell_keys},
     {"coupling.overlap.band", "a band overlap: the shell of a slab, DEM inside, across all of the third direction", band_keys},
+    {"coupling.overlap.band.follow", "a band that follows a crack: it moves, the scene built again around it", follow_keys},
 };
 
 using continuum::ContinuumSolver;
@@ -196,6 +204,7 @@ struct CouplingCaseSettings {
     std::array<bool, 3> components;
   };
   std::vector<Tie> ties{};  // resolved to DEs when the scene is coupled
+  std::optional<BandFollow> follow{};  // coupling.overlap.band.follow
 };
 
 // An error of the coupling library at its key in the case's coupling section: a SettingError
@@ -286,7 +295,8 @@ ContinuumCaseSettings read_continuum(CaseNode section, const std::string& extra_
   return out;
 }
 
-coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone::Weighting& weighting) {
+coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone::Weighting& weighting,
+                                   std::optional<BandFollow>& follow) {
   static constexpr std::string_view axes[] = {"x", "y", "z"};
   static constexpr std::string_view box_sides[] = {"lower", "upper"};
   static constexpr std::string_view cylinder_sides[] = {"base", "top"};
@@ -316,6 +326,16 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
     const double center = band.number("center", Range::any(), "m"), half = band.number("half_thickness", Range::positive(), "m");
     const double width = band.number("width", Range::positive(), "m");
     const double from = band.number("from", Range::any(), "m"), to = band.number("to", Range::any(), "m");
+    if (band.has("follow")) {
+      CaseNode f = band.child("follow");
+      follow = BandFollow{f.number("margin", Range::positive(), "m"), f.number("ahead", Range::positive(), "m"),
+                          f.number_or("behind", INFINITY, Range::positive(), "m"), f.number("until", Range::any(), "m"), axis, along, center, from, to,
+                          width, f.where()};
+      if (follow->ahead <= follow->margin)
+        f.fail("ahead", "expected more than margin (" + std::to_string(follow->margin) + " m): the band would move again at once");
+      if (follow->until < to) f.fail("until", "expected the band's furthest end, at or beyond its to (" + std::to_string(to) + " m)");
+      f.finish();
+    }
     band.finish();
     overlap.finish();
     try {
@@ -349,12 +369,14 @@ CouplingCaseSettings read_coupling(CaseNode section) {
   weighting.mass_floor = section.number_or("mass_floor", 0.05, Range::open_between(0.0, 1.0), "1");
   CaseNode overlap = section.child("overlap");
   std::optional<coupling::OverlapZone> zone;
+  std::optional<BandFollow> follow;
   try {
-    zone = read_overlap(overlap, weighting);
+    zone = read_overlap(overlap, weighting, follow);
   } catch (const InputError& e) {  // the zone's own checks (extents, inner and outer boxes)
     fail_at_coupling_key(section, e);
   }
   CouplingCaseSettings out{section, *zone};
+  out.follow = follow;
   static constexpr std::string_view mediators[] = {"coarse", "fine"};
   static constexpr std::string_view types[] = {"l2", "h1"};
   out.options.coupling.mediator = coupling::mediator_from_name(section.choice_or("mediator", "coarse", mediators));
@@ -394,6 +416,9 @@ class Coupled final : public SceneModel {
           bool stop_on_damage_in_overlap)
       : dem_(dem), continuum_(continuum), model_(std::move(model)), stop_on_damage_(stop_on_damage_in_overlap) {}
   void step(double dt) override { model_->step(dt); }
+  bool accepts_set_state() const override { return model_->opens_macro_step(); }
+  void resume_from_set_state() override { model_->resume_from_set_state(); }
+  double displacement_residual() const override { return model_->displacement_residual(); }
   std::optional<OverlapDamageReport> damage_in_overlap() override {
     const auto damage = model_->damage_in_overlap();
     if (!damage) return std::nullopt;
@@ -468,6 +493,49 @@ class Part final : public ContinuumPart {
   }
 
   bool in_dem_domain(const Vec3& x) const override { return !coupling_ || coupling_->zone.in_dem_domain(x); }
+  const std::optional<BandFollow>& band_follow() const override {
+    static const std::optional<BandFollow> none;
+    return coupling_ ? coupling_->follow : none;
+  }
+  const std::vector<Vec3>& node_positions() const override { return solver_->nodes(); }
+  double dem_weight(const Vec3& x) const override { return coupling_ ? coupling_->zone.alpha_d(x) : 0.0; }
+  double vertex_plane_from(int axis, double x) const override {
+    const continuum::Mesh& mesh = solver_->mesh();
+    double plane = INFINITY;
+    for (int e = 0; e < mesh.num_tets(); ++e)
+      for (int k = 0; k < 4; ++k)
+        if (const double c = mesh.nodes()[mesh.tet(e)[k]][axis]; c >= x && c < plane) plane = c;
+    return plane;
+  }
+  std::vector<std::uint8_t> node_sides(int axis, double center) const override {
+    const continuum::Mesh& mesh = solver_->mesh();
+    std::vector<std::uint8_t> side(mesh.num_nodes(), 0);
+    for (int e = 0; e < mesh.num_tets(); ++e) {
+      const int* t = mesh.tet(e);
+      double centroid = 0.0;
+      for (int k = 0; k < 4; ++k) centroid += 0.25 * mesh.nodes()[t[k]][axis];
+      for (int k = 0; k < mesh.nodes_per_tet(); ++k) side[t[k]] |= centroid < center ? 1 : 2;
+    }
+    return side;
+  }
+  void internal_force(const std::vector<double>& u, std::vector<double>& f) const override { solver_->internal_force(u, f); }
+  ShapeValues shape_values(const std::vector<Vec3>& points) const override {
+    ShapeValues rows(points.size());
+    const auto take = [&rows](const continuum::InterpolationOperator& N, std::size_t first) {
+      for (int p = 0; p < N.outerSize(); ++p)
+        for (continuum::InterpolationOperator::InnerIterator it(N, p); it; ++it)
+          if (it.value() != 0.0) rows[first + p].emplace_back(static_cast<int>(it.col()), it.value());
+    };
+    try {
+      take(solver_->interpolation(points), 0);
+    } catch (const InputError&) {  // a point outside the mesh: the others one by one
+      for (std::size_t p = 0; p < points.size(); ++p) try {
+          take(solver_->interpolation({points[p]}), p);
+        } catch (const InputError&) {
+        }
+    }
+    return rows;
+  }
   std::unique_ptr<SceneModel> couple(dem::DemModel& dem) override {
     coupling::CoupledOptions options = coupling_->options;
     options.held_continuum_dofs = held_dofs_;

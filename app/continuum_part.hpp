@@ -15,10 +15,14 @@
 // Then couple() gives the model that advances both together (the coupling finalizes the DEM).
 #pragma once
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "app/scene_model.hpp"
 #include "common/json.hpp"
@@ -38,6 +42,18 @@ class ContinuumSolver;
 
 namespace arlequin::app {
 
+// coupling.overlap.band.follow: a DEM band that moves along its direction to keep the crack of
+// the DEM's cohesive interface inside it (app/zone_move.hpp, docs/theory.md#moving-zone).
+struct BandFollow {
+  double margin = 0.0;  // m: it moves when the damage front comes within this of `to`
+  double ahead = 0.0;   // m: the new `to` is the damage front plus this (at most `until`)
+  double behind = INFINITY;  // m: the new `from` is the crack tip less this (never less than before); inf: it stays
+  double until = 0.0;   // m: the furthest `to`
+  int axis = 2, along = 0;                                 // the band's (0, 1, 2)
+  double center = 0.0, from = 0.0, to = 0.0, width = 0.0;  // m, the band as read
+  std::string where;                         // file:line of the follow section
+};
+
 class ContinuumPart {
  public:
   // Builds the continuum, cut by the coupling's overlap when `coupling` is given; InputError for
@@ -51,6 +67,22 @@ class ContinuumPart {
   virtual continuum::ContinuumSolver& solver() = 0;
   // Where DEs may be: the pure-DEM zone and the overlap of the coupling (everywhere if uncoupled).
   virtual bool in_dem_domain(const Vec3& x) const = 0;
+  // The coupling's band that follows a crack, if the case has one.
+  virtual const std::optional<BandFollow>& band_follow() const = 0;
+  // For a zone that moves (app/zone_move.hpp). The nodes' reference positions; per node, on
+  // which side of the plane x[axis] = center its elements lie (bit 0: one below, bit 1: one
+  // above, by their centroids), which tells the two faces of a slit apart; and at each reference
+  // point, its shape functions' non-zero values (node, N), none where it lies outside the mesh.
+  virtual const std::vector<Vec3>& node_positions() const = 0;
+  virtual double dem_weight(const Vec3& x) const = 0;  // the coupling's alpha_d at x (0 uncoupled)
+  // The smallest coordinate along `axis` at or beyond x of an element corner (vertex) node:
+  // where a band may end so that a join from there holds whole elements (+inf: none).
+  virtual double vertex_plane_from(int axis, double x) const = 0;
+  virtual std::vector<std::uint8_t> node_sides(int axis, double center) const = 0;
+  using ShapeValues = std::vector<std::vector<std::pair<int, double>>>;
+  virtual ShapeValues shape_values(const std::vector<Vec3>& points) const = 0;
+  // f_int(u) (3 values a node) of the continuum as weighted: K u for small strains.
+  virtual void internal_force(const std::vector<double>& u, std::vector<double>& f) const = 0;
   // The model that steps `dem` (built, with its boundary conditions, not finalized) and this
   // continuum together, coupled as the coupling section given to `read` says; it finalizes
   // the DEM. Its errors name their key in that section. std::invalid_argument for

@@ -137,8 +137,10 @@ void read_sensors(CaseNode root, Scene& scene) {
       }
       sensor.crack.bins = int(s.integer_or("bins", 8, Range::at_least(1)));
       const auto& set = *sets[sensor.crack.bond_set];
-      sensor.crack.initial_tip = dem::measure_crack(set, scene.dem.particles, sensor.crack.axis, sensor.crack.across,
-                                                    sensor.crack.bins).tip;
+      const auto& tips = scene.built_with.crack_initial_tips;
+      sensor.crack.initial_tip = tips.empty() ? dem::measure_crack(set, scene.dem.particles, sensor.crack.axis, sensor.crack.across,
+                                                                   sensor.crack.bins).tip
+                                              : tips.at(scene.sensors.size());
       const bool from_initial_tip = sensor.crack.quantity == Sensor::CrackQuantity::crack_growth ||
                                     sensor.crack.quantity == Sensor::CrackQuantity::softening_zone;
       if (from_initial_tip && std::isnan(sensor.crack.initial_tip))

@@ -2,6 +2,7 @@
 #include "app/runner.hpp"
 
 #include "app/checkpoint.hpp"
+#include "app/zone_move.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -96,7 +97,7 @@ class Outputs {
  public:
   // `run`: the run's identity, which tags its fields file (carried over by restarts).
   Outputs(const Scene& scene, std::uint64_t run, const StateArchive* restart, const std::filesystem::path& checkpoint_dir)
-      : scene_(scene), run_(run) {
+      : scene_(&scene), run_(run) {
     std::error_code ec;
     std::filesystem::create_directories(scene.output.dir, ec);
     if (ec) throw InputError("cannot create the output folder '" + scene.output.dir.string() + "': " + ec.message());
@@ -143,9 +144,9 @@ class Outputs {
                                                        const EnergyBalance& b) {
     row_.assign({time, double(step)});
     std::vector<std::pair<std::string, double>> values;
-    const auto names = sensor_columns(scene_);
+    const auto names = sensor_columns(*scene_);
     std::size_t column = 0;
-    for (const Sensor& s : scene_.sensors) {
+    for (const Sensor& s : scene_->sensors) {
       const Vec3 v = sensor_value(s);
       for (int k = 0; k < 3; ++k)
         if (s.component < 0 || s.component == k) {
@@ -156,15 +157,15 @@ class Outputs {
     const dem::Energies& e = energies.dem;
     for (double x : {e.kinetic, e.bond, e.contact, b.external_work, b.dissipated, e.fracture, energies.total(), b.balance})
       row_.push_back(x);
-    if (scene_.continuum) {
+    if (scene_->continuum) {
       row_.push_back(energies.continuum_kinetic);
       row_.push_back(energies.continuum_strain);
     }
-    if (const auto m = scene_.model->monitor())  // coupling_columns
+    if (const auto m = scene_->model->monitor())  // coupling_columns
       for (double x : {energies.coupling_work, m->constraint_residual, m->velocity_mismatch_rms, m->velocity_mismatch_max})
         row_.push_back(x);
-    if (scene_.dem.failure_enabled()) {
-      for (const auto& set : scene_.dem.bond_sets()) {
+    if (scene_->dem.failure_enabled()) {
+      for (const auto& set : scene_->dem.bond_sets()) {
         const auto broken = set->broken();
         row_.push_back(double(std::count(broken.begin(), broken.end(), 1)) / double(std::max<std::size_t>(1, set->size())));
       }
@@ -177,14 +178,21 @@ class Outputs {
   void write_fields(double time) {
     if (!fields_) return;
     fields_->begin_frame(time);
-    scene_.model->write_fields(*fields_, scene_.output);
+    scene_->model->write_fields(*fields_, scene_->output);
     fields_->end_frame();
   }
 
   void close() {
     series_->flush();
-    if (scene_.dem.failure_enabled()) write_breaks(true);
+    if (scene_->dem.failure_enabled()) write_breaks(true);
     if (fields_) fields_->close();
+  }
+  // A zone that moved (app/zone_move.hpp) goes on in `scene`: the breaks so far are written,
+  // and those the new scene keeps of them (the bonds it has too) are not written again.
+  void follow(const Scene& scene) {
+    if (scene_->dem.failure_enabled()) write_breaks(true);
+    scene_ = &scene;
+    breaks_formatted_ = breaks_on_disk_ = scene.dem.breaks().size();
   }
   const CsvSeries& series() const { return *series_; }
   std::size_t frames_carried() const { return frames_carried_; }
@@ -192,7 +200,7 @@ class Outputs {
   // The case's plots of series.csv columns, drawn once the file is complete.
   void write_plots() const {
     std::vector<Plot> plots;
-    for (const PlotPlan& plan : scene_.output.plots) {
+    for (const PlotPlan& plan : scene_->output.plots) {
       Plot& plot = plots.emplace_back();
       plot.file = plan.file.string();
       plot.title = plan.title;
@@ -221,20 +229,20 @@ class Outputs {
         plot.curves.push_back(c);
       }
     }
-    arlequin::write_plots(scene_.output.dir, plots);
+    arlequin::write_plots(scene_->output.dir, plots);
   }
 
  private:
   Vec3 sensor_value(const Sensor& s) const {
     switch (s.kind) {
       case Sensor::Kind::force:
-        return s.on_continuum ? scene_.continuum->reaction_on(s.group_name) : scene_.dem.reaction_on(s.group);
+        return s.on_continuum ? scene_->continuum->reaction_on(s.group_name) : scene_->dem.reaction_on(s.group);
       case Sensor::Kind::displacement:
-        return s.on_continuum ? scene_.continuum->mean_displacement(s.group_name) : scene_.dem.mean_displacement(s.group);
+        return s.on_continuum ? scene_->continuum->mean_displacement(s.group_name) : scene_->dem.mean_displacement(s.group);
       case Sensor::Kind::velocity:
-        return s.on_continuum ? scene_.continuum->mean_velocity(s.group_name) : scene_.dem.mean_velocity(s.group);
+        return s.on_continuum ? scene_->continuum->mean_velocity(s.group_name) : scene_->dem.mean_velocity(s.group);
       case Sensor::Kind::energy:
-        return {scene_.dem.group_energy(s.group), 0.0, 0.0};
+        return {scene_->dem.group_energy(s.group), 0.0, 0.0};
       case Sensor::Kind::affine_deviation:
         return {affine_deviation(), 0.0, 0.0};
       case Sensor::Kind::crack:
@@ -244,14 +252,14 @@ class Outputs {
   }
 
   double crack_measure(const Sensor::Crack& c) const {
-    const auto m = dem::measure_crack(*scene_.dem.bond_sets()[c.bond_set], scene_.dem.particles, c.axis, c.across, c.bins);
+    const auto m = dem::measure_crack(*scene_->dem.bond_sets()[c.bond_set], scene_->dem.particles, c.axis, c.across, c.bins);
     switch (c.quantity) {
       case Sensor::CrackQuantity::tip: return m.tip;
       case Sensor::CrackQuantity::damage_front: return m.damage_front;
       case Sensor::CrackQuantity::crack_growth: return m.tip - c.initial_tip;
       case Sensor::CrackQuantity::softening_zone: return m.damage_front - c.initial_tip;
       case Sensor::CrackQuantity::process_zone: return m.damage_front - m.tip;
-      case Sensor::CrackQuantity::dissipated: return m.dissipated;
+      case Sensor::CrackQuantity::dissipated: return m.dissipated + c.dissipated_left;
     }
     return 0.0;
   }
@@ -259,9 +267,9 @@ class Outputs {
   // max |u - H X| / max |H X| over the DEs (u = position - reference, X = reference) and the
   // continuum nodes.
   double affine_deviation() const {
-    const auto& H = *scene_.initial_gradient;
-    std::array<double, 2> m = scene_.continuum ? scene_.continuum->affine_deviation(H) : std::array<double, 2>{0.0, 0.0};
-    const dem::ParticleSet& p = scene_.dem.particles;
+    const auto& H = *scene_->initial_gradient;
+    std::array<double, 2> m = scene_->continuum ? scene_->continuum->affine_deviation(H) : std::array<double, 2>{0.0, 0.0};
+    const dem::ParticleSet& p = scene_->dem.particles;
     for (std::size_t i = 0; i < p.size(); ++i) {
       const Vec3& X = p.reference[i];
       const Vec3 affine = rows_times(H, X);
@@ -275,12 +283,12 @@ class Outputs {
   // file is rewritten atomically at most every 2 s of wall time (as series.csv) and at close,
   // so a long failure run with many breaks costs linear, not quadratic, I/O.
   void write_breaks(bool force) {
-    const auto& breaks = scene_.dem.breaks();
+    const auto& breaks = scene_->dem.breaks();
     if (breaks_text_.empty()) breaks_text_ = "time,set,bond,first,second,group,criterion,mode,stress,energy,mode_mix\n";
     char line[320], mix[32] = "";
     for (; breaks_formatted_ < breaks.size(); ++breaks_formatted_) {
       const auto& e = breaks[breaks_formatted_];
-      const auto& set = *scene_.dem.bond_sets()[e.set];
+      const auto& set = *scene_->dem.bond_sets()[e.set];
       if (e.mode_mix >= 0.0) std::snprintf(mix, sizeof mix, "%.6g", e.mode_mix);
       std::snprintf(line, sizeof line, "%.12g,%u,%u,%u,%u,%s,%s,%s,%.9g,%.9g,%s\n", e.time, e.set, e.bond, set.first()[e.bond],
                     set.second()[e.bond], set.name.c_str(), std::string(dem::name_of(e.criterion)).c_str(),
@@ -290,7 +298,7 @@ class Outputs {
     const auto now = std::chrono::steady_clock::now();
     const bool stale = breaks_on_disk_ < breaks_formatted_ || !breaks_file_written_;
     if (!stale || (!force && breaks_file_written_ && now - breaks_last_write_ < std::chrono::seconds(2))) return;
-    write_file_atomically(scene_.output.dir / "breaks.csv", breaks_text_);
+    write_file_atomically(scene_->output.dir / "breaks.csv", breaks_text_);
     breaks_on_disk_ = breaks_formatted_;
     breaks_file_written_ = true;
     breaks_last_write_ = now;
@@ -323,7 +331,7 @@ class Outputs {
                  times.size(), why.c_str());
   }
 
-  const Scene& scene_;
+  const Scene* scene_;
   std::uint64_t run_;
   std::size_t rows_on_schedule_ = 0, frames_on_schedule_ = 0;
   std::size_t frames_carried_ = 0;  // frames copied from before a restart
@@ -474,14 +482,17 @@ std::string unbalanced(double balance, double budget, const std::vector<std::pai
   return msg.str();
 }
 
-RunResult run_scene(Scene& scene, const RunOptions& options) {
-  dem::DemModel& model = scene.dem;
-  long total_steps = scene.steps;
-  const bool static_only = scene.static_only();  // one solve, whatever --steps says
+RunResult run_scene(Scene& built, const RunOptions& options) {
+  // The scene the run steps: the one built, or the last a zone that follows a crack moved to.
+  Scene* scene = &built;
+  std::unique_ptr<Scene> moved;
+  dem::DemModel* model = &scene->dem;
+  long total_steps = scene->steps;
+  const bool static_only = scene->static_only();  // one solve, whatever --steps says
   if (options.max_steps >= 0) total_steps = std::min(total_steps, options.max_steps);
 
   RunResult result;
-  double initial_total = scene.model->energies().total() - continuum_balance_terms(scene).second;
+  double initial_total = scene->model->energies().total() - continuum_balance_terms(*scene).second;
   // A healthy run's kinetic energy stays below what it started with plus the work put in;
   // far above that (x100) the run has blown up. The first step's kinetic energy counts
   // the motion that boundary conditions impose. A scene at rest has round-off forces (a bond's
@@ -492,12 +503,12 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   // the energy scale is at least that motion's, round_off (eps X / dt_c) times (t / dt_c)^2
   // (~4e-21 J there after 5600 steps). Both from the scene as built, before a restart moves it.
   double energy_scale = std::abs(initial_total);
-  const double round_off = model.round_off_kinetic_energy(scene.dt_critical);
+  const double round_off = model->round_off_kinetic_energy(scene->dt_critical);
   double output_seconds = 0.0, next_row = 0.0, next_frame = 0.0;
-  const double checkpoint_every = scene.output.checkpoint_every;
+  const double checkpoint_every = scene->output.checkpoint_every;
   double next_checkpoint = checkpoint_every;
   // Float steps accumulate round-off: an output is due within a millionth of a step.
-  const double slack = 1e-6 * scene.dt;
+  const double slack = 1e-6 * scene->dt;
   long steps_done = 0;
   // Tags the run's fields file, so that a restart takes frames from its own run's file only; a
   // restarted run keeps its run's. Not a simulation value: nothing in the physics reads it.
@@ -508,17 +519,17 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   const StateArchive* restart = options.restart;
   if (restart) {
     const std::string file = "'" + options.restart_file.string() + "'";
-    check_same_run(*restart, scene, options.restart_file);
+    check_same_run(*restart, *scene, options.restart_file);
     try {
       run_id = static_cast<std::uint64_t>(restart->integer("run/id"));
       steps_done = restart->integer("run/steps_done");
-      if (steps_done < 0 || (model.particles.size() > 0 && restart->integer("dem/steps") != steps_done))
+      if (steps_done < 0 || (model->particles.size() > 0 && restart->integer("dem/steps") != steps_done))
         throw StateMismatch("its step counts disagree (run " + std::to_string(steps_done) + ")");
       next_row = restart->number("run/next_row");
       next_frame = restart->number("run/next_frame");
       initial_total = restart->number("run/initial_total");
       energy_scale = restart->number("run/energy_scale");
-      const auto names = series_columns(scene);
+      const auto names = series_columns(*scene);
       const std::string columns = column_list(names);
       if (restart->text("run/series_columns") != columns)
         throw StateMismatch("its series.csv has the columns '" + restart->text("run/series_columns") + "', this scene '" + columns + "'");
@@ -534,23 +545,23 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
       throw InputError(file + " is not a checkpoint of this scene: " + e.what());
     }
     // A restart has steps to run: a finished run is extended by a later time.end.
-    if (steps_done >= scene.steps)
-      throw InputError(file + " is at step " + std::to_string(steps_done) + (steps_done == scene.steps ? ", the last" : ", past the last") +
-                       " of this case (time.end " + std::to_string(scene.end_time) + " s): give a later time.end to continue it");
+    if (steps_done >= scene->steps)
+      throw InputError(file + " is at step " + std::to_string(steps_done) + (steps_done == scene->steps ? ", the last" : ", past the last") +
+                       " of this case (time.end " + std::to_string(scene->end_time) + " s): give a later time.end to continue it");
     if (total_steps <= steps_done)
       throw InputError("--steps " + std::to_string(total_steps) + ": the run would stop at or before step " +
                        std::to_string(steps_done) + ", where " + file + " restarts it");
-    next_checkpoint = steps_done * scene.dt + checkpoint_every;  // the case's interval, from here
-    load_scene_state(scene, *restart, options.restart_file);
+    next_checkpoint = steps_done * scene->dt + checkpoint_every;  // the case's interval, from here
+    load_scene_state(*scene, *restart, options.restart_file);
   }
-  Outputs outputs(scene, run_id, restart, options.restart_file.parent_path());
+  Outputs outputs(*scene, run_id, restart, options.restart_file.parent_path());
   // The runner's part of the checkpoint: where the run is, its output schedule, the scales its
   // checks use, and what it has reported; the rows and frames are the outputs'.
   std::string checkpoint_error;  // the first checkpoint that could not be written
   const auto save_checkpoint = [&] {
     StateArchive archive;
-    put_run_identity(archive, scene);
-    scene.model->save_state(archive);
+    put_run_identity(archive, *scene);
+    scene->model->save_state(archive);
     archive.put("run/id", static_cast<std::int64_t>(run_id));
     archive.put("run/steps_done", std::int64_t{steps_done});
     for (const auto& [name, value] : {std::pair{"next_row", next_row}, {"next_frame", next_frame}, {"initial_total", initial_total}, {"energy_scale", energy_scale}})
@@ -563,7 +574,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     outputs.save_state(archive);
     // A checkpoint that cannot be written (a full disk) does not stop the run: the last one stays.
     try {
-      write_state_file(scene.output.dir / checkpoint_file_name, archive);
+      write_state_file(scene->output.dir / checkpoint_file_name, archive);
     } catch (const RunError& e) {
       if (checkpoint_error.empty()) {
         std::fprintf(stderr, "  warning: %s; the run goes on, its last checkpoint stays\n", e.what());
@@ -573,11 +584,11 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   };
   const long first_step = steps_done;
   Progress progress(options.show_progress, options.announce_run_time, first_step, total_steps);
-  const auto current_time = [&] { return steps_done * scene.dt; };
+  const auto current_time = [&] { return steps_done * scene->dt; };
   // Outputs are written after step n when it ends on a row or a frame, or is the last.
-  const auto output_after = [&](long n) { return n * scene.dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
+  const auto output_after = [&](long n) { return n * scene->dt + slack >= std::min(next_row, next_frame) || n == total_steps; };
   const std::string likely_cause =
-      std::string(scene.continuum ? "the continuum's force taken once every too many steps (coupling.continuum_substeps: an "
+      std::string(scene->continuum ? "the continuum's force taken once every too many steps (coupling.continuum_substeps: an "
                                     "impulse method's resonance, docs/theory.md#continuum-substeps), "
                                   : "") +
       "a time step too close to the stability limit, or work a boundary condition does not report";
@@ -589,19 +600,19 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     // run stopped early (--steps) and restarted keeps the schedule of the uninterrupted run.
     const bool row_due = current_time() + slack >= next_row, frame_due = current_time() + slack >= next_frame;
     const bool last = steps_done == total_steps;
-    const SceneEnergies energies = row_due || last ? scene.model->energies() : SceneEnergies{model.energies()};
+    const SceneEnergies energies = row_due || last ? scene->model->energies() : SceneEnergies{model->energies()};
     result.energies = energies.dem;
     if (row_due || last) {
-      const EnergyBalance balance = energy_balance(scene, energies, initial_total);
+      const EnergyBalance balance = energy_balance(*scene, energies, initial_total);
       result.sensors = outputs.write_row(current_time(), steps_done, energies, balance);
       // The balance's verdict (after the row, which shows it), for a time loop (a static solve's
       // balance is its complementary energy): what it is measured against is the blow-up test's
       // scale (the start's energy, or the round-off floor) and the energy flow.
       if (!static_only) {
-        const double start = std::max(energy_scale, round_off * std::pow(current_time() / scene.dt_critical, 2));
+        const double start = std::max(energy_scale, round_off * std::pow(current_time() / scene->dt_critical, 2));
         const dem::Energies& e = energies.dem;
         std::vector<std::pair<std::string, double>> parts{{"DEM kinetic", e.kinetic}, {"bonds", e.bond}, {"contacts", e.contact}};
-        if (scene.continuum)
+        if (scene->continuum)
           parts.insert(parts.end(), {{"continuum kinetic", energies.continuum_kinetic}, {"continuum strain", energies.continuum_strain}});
         if (const std::string why = unbalanced(balance.balance, start + balance.flow, parts, likely_cause); !why.empty()) {
           std::ostringstream at;
@@ -609,34 +620,80 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
           throw RunError(at.str() + why);
         }
       }
-      if (row_due) next_row += scene.output.every, outputs.mark_rows_on_schedule();
+      if (row_due) next_row += scene->output.every, outputs.mark_rows_on_schedule();
       if (options.stop_after_row) result.stop_reason = options.stop_after_row(result.sensors);
     }
     if (frame_due || last) {
       outputs.write_fields(current_time());
-      if (frame_due) next_frame += scene.output.fields_every, outputs.mark_frames_on_schedule();
+      if (frame_due) next_frame += scene->output.fields_every, outputs.mark_frames_on_schedule();
     }
     output_seconds += seconds_since(t0);
   };
 
   // --profile: the DEM times its phases, the runner its own, and the rest of a model step (the
   // continuum and the coupling) is one phase.
-  StepProfile* const profile = scene.profile;
+  StepProfile* const profile = scene->profile;
   struct {
     int checks = 0, outputs = 0, rest = 0;
   } phase;
   if (profile) {
-    model.set_profile(profile);
-    if (scene.continuum) phase.rest = profile->phase("continuum and coupling");
+    model->set_profile(profile);
+    if (scene->continuum) phase.rest = profile->phase("continuum and coupling");
     phase.checks = profile->phase("energy and overlap checks");
     phase.outputs = profile->phase("sensors, energies, output");
   }
   const auto step_model = [&] {
-    if (!profile || !scene.continuum) return scene.model->step(scene.dt);
+    if (!profile || !scene->continuum) return scene->model->step(scene->dt);
     const double timed_before = profile->seconds();
     const auto t0 = Clock::now();
-    scene.model->step(scene.dt);
+    scene->model->step(scene->dt);
     profile->add(phase.rest, std::max(0.0, seconds_since(t0) - (profile->seconds() - timed_before)), true);
+  };
+
+  // A band that follows a crack (app/zone_move.hpp): looked at every zone_check_steps steps,
+  // between two macro steps; each move's energy jump is its own term of the balance (the start's
+  // total moves by it), and what it leaves behind stays counted.
+  const bool follows = scene->continuum && scene->continuum->band_follow();
+  constexpr long zone_check_steps = 100;
+  Json zone_moves = Json::array();
+  std::size_t breaks_left_behind = 0;
+  std::optional<double> first_break_time;
+  double zone_energy_jumps = 0.0;
+  const auto move_zone_to = [&](BandPlace place) {
+    const std::size_t breaks_before = model->breaks().size();
+    if (!first_break_time && breaks_before > 0) first_break_time = model->breaks().front().time;
+    ZoneMove move;
+    std::unique_ptr<Scene> next = move_zone(built, *scene, place, move);
+    if (profile) model->set_profile(nullptr), next->dem.set_profile(profile);
+    outputs.follow(*next);
+    moved = std::move(next);
+    scene = moved.get();
+    model = &scene->dem;
+    breaks_left_behind += breaks_before - model->breaks().size();
+    initial_total += move.energy_jump();
+    zone_energy_jumps += move.energy_jump();
+    Json row = Json::object();
+    row["step"] = steps_done;
+    row["time"] = current_time();
+    row["from"] = place.from;
+    row["to"] = place.to;
+    row["particles"] = move.des;
+    row["particles_added"] = move.des_added;
+    row["particles_dropped"] = move.des_dropped;
+    row["continuum_nodes_added"] = move.nodes_added;
+    row["continuum_nodes_from_des"] = move.nodes_from_des;
+    row["particles_onto_continuum"] = move.des_onto_continuum;
+    row["displacement_residual"] = scene->model->displacement_residual();
+    row["broken_bonds_left_behind"] = move.links_dropped_broken;
+    row["energy_jump"] = move.energy_jump();
+    row["energy_before"] = move.energy_before;
+    row["seconds"] = move.setup_seconds;
+    zone_moves.push_back(row);
+    std::fprintf(stderr,
+                 "  the band moved at step %ld (t = %.6g s) to [%.6g, %.6g] m: %zu DEs (%zu added, %zu dropped), %zu continuum nodes "
+                 "added, energy %+.3g J of %.3g J, %.2f s\n",
+                 steps_done, current_time(), place.from, place.to, move.des, move.des_added, move.des_dropped, move.nodes_added, move.energy_jump(),
+                 move.energy_before, move.setup_seconds);
   };
 
   const auto t_start = Clock::now();
@@ -649,21 +706,21 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   };
   try {
     if (static_only) {
-      scene.continuum->solve_static();  // a static continuum alone: one solve, one output
+      scene->continuum->solve_static();  // a static continuum alone: one solve, one output
       total_steps = 0;
     }
     if (!restart) write_outputs();
     for (long n = first_step + 1; n <= total_steps; ++n) {
       if (const int signal = take_interrupt()) throw interruption(signal);
-      if (output_after(n)) model.record_energies_in_next_step();  // the step's force pass gives the row's bond energies
+      if (output_after(n)) model->record_energies_in_next_step();  // the step's force pass gives the row's bond energies
       step_model();
       ++steps_done;
       if (profile) profile->count_step();
-      model.check_finite();  // the DEM times it
+      model->check_finite();  // the DEM times it
       {
         const PhaseTimer timer(profile, phase.checks, false);
-        if (n == 1) energy_scale = std::max(energy_scale, model.kinetic_energy());
-        if (const auto damage = scene.model->damage_in_overlap()) {
+        if (n == 1) energy_scale = std::max(energy_scale, model->kinetic_energy());
+        if (const auto damage = scene->model->damage_in_overlap()) {
           const bool first = result.damage_in_overlap.empty();
           if (first) result.damage_in_overlap = "step " + std::to_string(n) + ": " + damage->description;
           result.damage_in_overlap_breaks += damage->breaks;
@@ -674,8 +731,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
                          damage->held ? "hold" : "warn");
         }
         if (n % 50 == 0 || n == total_steps)
-          model.check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene.dt / scene.dt_critical, 2)) +
-                                      std::abs(model.external_work() + continuum_work(scene))) +
+          model->check_energy(100.0 * (std::max(energy_scale, round_off * std::pow(n * scene->dt / scene->dt_critical, 2)) +
+                                      std::abs(model->external_work() + continuum_work(*scene))) +
                              1e-300);
       }
       {
@@ -687,6 +744,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
         }
         progress.update(n, current_time());
       }
+      if (follows && n % zone_check_steps == 0 && n < total_steps && scene->model->accepts_set_state())
+        if (const std::optional<BandPlace> place = band_place(*scene)) move_zone_to(*place);
       if (!result.stop_reason.empty()) break;
     }
   } catch (const RunError& e) {
@@ -695,9 +754,10 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
     failure = e.what();
     interrupted = std::current_exception();
   }
-  if (profile) model.set_profile(nullptr);
+  if (profile) model->set_profile(nullptr);
   // The state at the end, or where a signal stopped the run: between two steps, so whole.
-  if (!static_only && (interrupted || (failure.empty() && checkpoint_every > 0.0))) save_checkpoint();
+  // (Not of a zone that moved: its case is no longer the case's, zone_move.hpp.)
+  if (!static_only && !moved && (interrupted || (failure.empty() && checkpoint_every > 0.0))) save_checkpoint();
   progress.finish();
   result.steps = steps_done;
   result.simulated_time = current_time();
@@ -707,8 +767,8 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   outputs.write_plots();
 
   Json summary = Json::object();
-  summary["name"] = scene.name;
-  summary["case_file"] = std::filesystem::absolute(scene.case_file).string();
+  summary["name"] = scene->name;
+  summary["case_file"] = std::filesystem::absolute(scene->case_file).string();
   summary["version"] = ARLEQUIN_VERSION;
   summary["status"] = failure.empty() ? "completed" : interrupted ? "interrupted" : "failed";
   if (!failure.empty()) summary["error"] = failure;
@@ -725,20 +785,25 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   }
   summary["steps"] = result.steps;
   summary["simulated_time"] = result.simulated_time;
-  summary["dt"] = scene.dt;
-  summary["dt_critical"] = scene.dt_critical;
+  summary["dt"] = scene->dt;
+  summary["dt_critical"] = scene->dt_critical;
   Json& counts = summary["counts"];
-  counts["particles"] = model.particles.size();
-  if (scene.des_not_created > 0) counts["particles_not_created"] = scene.des_not_created;
-  if (model.failure_enabled()) counts["broken_bonds"] = model.breaks().size();
-  if (!model.breaks().empty()) summary["first_break_time"] = model.breaks().front().time;  // s; events are in time order
-  if (!model.bond_sets().empty()) {
-    Json& bonds = counts["bonds"];
-    for (const auto& set : model.bond_sets()) bonds[set->name] = set->size();
+  counts["particles"] = model->particles.size();
+  if (scene->des_not_created > 0) counts["particles_not_created"] = scene->des_not_created;
+  if (model->failure_enabled()) counts["broken_bonds"] = model->breaks().size() + breaks_left_behind;
+  if (!first_break_time && !model->breaks().empty()) first_break_time = model->breaks().front().time;  // s; events are in time order
+  if (first_break_time) summary["first_break_time"] = *first_break_time;
+  if (follows) {
+    summary["zone_moves"] = zone_moves;
+    summary["zone_energy_jumps"] = zone_energy_jumps;
   }
-  if (scene.continuum) scene.continuum->describe(counts);
-  scene.model->describe(counts);
-  if (const auto* list = model.neighbours()) {
+  if (!model->bond_sets().empty()) {
+    Json& bonds = counts["bonds"];
+    for (const auto& set : model->bond_sets()) bonds[set->name] = set->size();
+  }
+  if (scene->continuum) scene->continuum->describe(counts);
+  scene->model->describe(counts);
+  if (const auto* list = model->neighbours()) {
     counts["contact_candidates"] = list->pairs().size();
     counts["neighbour_rebuilds"] = list->builds();
   }
@@ -749,11 +814,11 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   wall["steps_per_second"] = steps_per_second(result);
   summary["energies"] = energies_json(result.energies);
   // The checks are stated for the whole case: a run cut short by --steps is not judged.
-  if (failure.empty() && !scene.checks.empty() && !static_only && options.max_steps >= 0 && options.max_steps < scene.steps)
-    result.checks_skipped = "the run stopped at step " + std::to_string(result.steps) + " of " + std::to_string(scene.steps) +
+  if (failure.empty() && !scene->checks.empty() && !static_only && options.max_steps >= 0 && options.max_steps < scene->steps)
+    result.checks_skipped = "the run stopped at step " + std::to_string(result.steps) + " of " + std::to_string(scene->steps) +
                             " (--steps), before time.end";
   else if (failure.empty())
-    result.checks = evaluate_checks(scene, outputs.series());
+    result.checks = evaluate_checks(built, outputs.series());
   if (!result.checks_skipped.empty()) summary["checks_skipped"] = result.checks_skipped;
   Json& checks = summary["checks"];
   checks = Json::array();
@@ -777,7 +842,7 @@ RunResult run_scene(Scene& scene, const RunOptions& options) {
   Json& sensors = summary["sensors"];
   sensors = Json::object();
   for (const auto& [name, value] : result.sensors) sensors[name] = value;
-  write_json_atomically(scene.output.dir / "summary.json", summary);
+  write_json_atomically(scene->output.dir / "summary.json", summary);
   if (interrupted) std::rethrow_exception(interrupted);
   if (!failure.empty()) throw RunError(failure);
   // A signal after the last step (final outputs, a static solve) leaves this run complete but

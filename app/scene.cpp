@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // build_scene: a case file read section by section (scene_readers.hpp), then the time step.
 #include "app/scene.hpp"
+#include "app/zone_move.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -81,6 +82,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   Scene scene;
   scene.case_file = case_file;
   scene.profile = options.profile;
+  scene.built_with = options;
   scene.name = root.string_or("name", case_file.parent_path().filename().string());
   // The name is the default output folder's last component (results/<name>) and the packing
   // cache's: one plain component of portable characters, so that it cannot reach outside
@@ -188,6 +190,7 @@ Scene build_scene(const std::filesystem::path& case_file, const SceneOptions& op
   }
   root.finish();
   scene.resolved_case = file.resolved_yaml();
+  if (scene.continuum && scene.continuum->band_follow()) check_band_follow(scene);
   return scene;
 }
 

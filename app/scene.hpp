@@ -42,6 +42,7 @@ struct Sensor {
     Vec3 axis{1, 0, 0}, across{0, 1, 0};  // unit vectors
     int bins = 8;
     double initial_tip = 0.0;  // m, the tip when the scene was built (the pre-crack's)
+    double dissipated_left = 0.0;  // J, by links a moving zone left behind (app/zone_move.hpp)
   } crack;
 };
 
@@ -92,6 +93,20 @@ struct OutputPlan {
   std::vector<PlotPlan> plots;
 };
 
+struct SceneOptions {
+  std::vector<Override> overrides;     // --set key=value, and those of sweeps and spec files
+  std::filesystem::path out_dir;       // --out, empty = from the case
+  std::string petsc_options;           // --petsc "...", after the case's own
+  bool rebuild_sample = false;         // build the packing even if its cache file matches
+  bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
+  bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
+  StepProfile* profile = nullptr;      // --profile: runs time their step's phases into it
+  double time_step_scale = 1.0;        // dt (auto or given) times this, at most 1: compare --ensemble's perturbation
+  // A zone that moved (app/zone_move.hpp): the crack sensors' pre-crack tips, in the order of the
+  // sensors, as the run's scene first measured them (the moved zone may hold no pre-crack).
+  std::vector<double> crack_initial_tips{};
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path case_file;
@@ -113,21 +128,12 @@ struct Scene {
   std::vector<Check> checks;
   OutputPlan output;
   StepProfile* profile = nullptr;  // SceneOptions::profile
+  SceneOptions built_with;         // what build_scene was given (a zone that moves builds it again)
 
   // A static continuum and no DE: one solve, no time stepping (time is optional).
   bool static_only() const { return continuum && continuum->is_static() && dem.particles.size() == 0; }
 };
 
-struct SceneOptions {
-  std::vector<Override> overrides;     // --set key=value, and those of sweeps and spec files
-  std::filesystem::path out_dir;       // --out, empty = from the case
-  std::string petsc_options;           // --petsc "...", after the case's own
-  bool rebuild_sample = false;         // build the packing even if its cache file matches
-  bool check_output_dir = true;        // refuse an output folder that cannot be written (not for `check`)
-  bool write_sample_cache = true;      // save a packing built now to its cache file (not for `check`)
-  StepProfile* profile = nullptr;      // --profile: runs time their step's phases into it
-  double time_step_scale = 1.0;        // dt (auto or given) times this, at most 1: compare --ensemble's perturbation
-};
 
 // The options of `arlequin check` (and of the fuzz targets, which read as it does): those given,
 // writing nothing, so that a case is validated where nothing can be written.

@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "common/fields_writer.hpp"
@@ -60,6 +61,15 @@ class SceneModel {
   // holds; load_state on the model built again from the same case (StateMismatch if it is not).
   virtual void save_state(StateArchive& archive) const = 0;
   virtual void load_state(const StateArchive& archive) = 0;
+  // A zone that moves (app/zone_move.hpp) sets the state of a model built for the new zone
+  // from the one it replaces, through save_state's archive, between two steps where
+  // accepts_set_state(); resume_from_set_state() then makes the forces and the coupling's
+  // constraint those of that state. Only a coupled model follows a zone.
+  virtual bool accepts_set_state() const { return false; }
+  virtual void resume_from_set_state() { throw std::logic_error("only a coupled scene's state is set from outside"); }
+  // |G_d u_d + G_c u_c| / |G_d u_d| (coupling/coupled_model.hpp), 0 uncoupled: how far a state
+  // set from outside is off the displacement constraint, which the coupling keeps as it finds it.
+  virtual double displacement_residual() const { return 0.0; }
   virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)
   virtual void describe(Json& counts) const {}       // summary.json counts of its own
 };

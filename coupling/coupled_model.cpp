@@ -113,13 +113,24 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   for (int d : options_.held_continuum_dofs) inv_mass_c_.at(d) = 0.0;
   untie_prescribed_rows();
   solver_ = std::make_unique<MultiplierSolver>(ops_, inv_mass_d_, inv_mass_c_, options_.multiplier_petsc_options);
+  put_state_on_constraint();
 
-  // Initial velocities onto the constraint.
+  time_steps_.dem = dem_.critical_time_step();
+  time_steps_.continuum = continuum_.critical_time_step();
+  if (options_.continuum_substeps == 0)  // auto (header)
+    options_.continuum_substeps = std::max(1, static_cast<int>(std::floor(time_steps_.continuum / time_steps_.dem)));
+  time_steps_.continuum_substeps = options_.continuum_substeps;
+  time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum / options_.continuum_substeps);
+}
+
+// The velocities onto G v = 0, and the constraint force of the present forces: the projection of
+// the unconstrained accelerations (what the first half kick of the next step applies).
+void CoupledModel::put_state_on_constraint() {
+  const int np = ops_.num_particles(), nn = continuum_.num_nodes();
   gather_dem_velocity(vd_);
   Matrix3 dd, dc;
   solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);
   scatter_dem_velocity(vd_);
-  // Constraint force at t = 0: the projection of the unconstrained accelerations.
   Matrix3 ad(np, 3);
   for (int p = 0; p < np; ++p) {
     const Vec3& f = dem_.particles.force[ops_.particles[p]];
@@ -128,13 +139,12 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
   Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
       Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
   solver_->project(ad, ac, acc_d_, acc_c_, mu_);
+}
 
-  time_steps_.dem = dem_.critical_time_step();
-  time_steps_.continuum = continuum_.critical_time_step();
-  if (options_.continuum_substeps == 0)  // auto (header)
-    options_.continuum_substeps = std::max(1, static_cast<int>(std::floor(time_steps_.continuum / time_steps_.dem)));
-  time_steps_.continuum_substeps = options_.continuum_substeps;
-  time_steps_.coupled = std::min(time_steps_.dem, time_steps_.continuum / options_.continuum_substeps);
+void CoupledModel::resume_from_set_state() {
+  dem_.restart_forces();
+  continuum_.compute_forces();
+  put_state_on_constraint();
 }
 
 // The targets of the contract's consistent quadrature: g_a = sum_p N(p, a) h_p, h_p = sum over

@@ -192,6 +192,13 @@ class CoupledModel {
   // on the coupled model built again from the same case continues bit for bit.
   void save_state(StateArchive& archive) const;
   void load_state(const StateArchive& archive);
+  // After both models' states were set from outside between two steps (a zone that moved,
+  // app/zone_move.hpp: DEs and nodes carried over from another scene, the new ones interpolated):
+  // their forces again, the velocities onto the constraint and its force, as at construction.
+  void resume_from_set_state();
+  // Whether the next step opens a macro step of options.continuum_substeps (its continuum force
+  // is then that of the present state): where a state may be set from outside.
+  bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }
 
   const OverlapZone& zone() const { return zone_; }
   const CouplingOperators& operators() const { return ops_; }
@@ -204,13 +211,15 @@ class CoupledModel {
 
  private:
   void untie_prescribed_rows();
+  // The constructor's and resume_from_set_state's last part: the velocities onto G v = 0, the
+  // constraint force of the present forces.
+  void put_state_on_constraint();
   // The phases of step(), in order (see the contract above).
   void constraint_half_kick(double dt);
   void advance_models(double dt);
   void kick_to_trial(double dt);
-  // Whether the step in progress is the first, or the last, of a macro step of the continuum's
-  // substeps (both when there is one substep).
-  bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }
+  // Whether the step in progress is the last of a macro step of the continuum's substeps (during
+  // a step, opens_macro_step() says whether it is the first; both when there is one substep).
   bool closes_macro_step() const { return (steps_ + 1) % options_.continuum_substeps == 0; }
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
 

@@ -144,6 +144,10 @@ void DemModel::finalize() {
   if (rdef_) rdef_->prepare(particles, group_members_);
   failure_on_ = rdef_.has_value() ||
                 std::any_of(bond_sets_.begin(), bond_sets_.end(), [](const auto& set) { return set->has_strength(); });
+  restart_forces();
+}
+
+void DemModel::restart_forces() {
   compute_forces();
   record_reactions();
   apply_loads_and_damping();

@@ -82,6 +82,10 @@ class DemModel {
   void enable_rdef(const RdefSettings& settings) { rdef_.emplace(settings); }
 
   void finalize();
+  // The forces and torques of the present state, as finalize() puts them before the first step
+  // (bonds, contacts, reactions, loads, damping): what the next step's first kick reads, after
+  // the state was set from outside between two steps (a zone moved, app/zone_move.hpp).
+  void restart_forces();
 
   // Critical time step 2 / omega_max, omega_max^2 from the block-Gershgorin bound over
   // bonds and contacts, lowered by damping (docs/theory.md#critical-step). Contacts count as

@@ -105,7 +105,10 @@ TEST_F(SchemaTest, EveryDeclaredKeyIsReadByItsReader) {
             {"dem.sample.radius.mean=4.0e-4", "dem.sample.file=" + (dir_ / "dcb_sample.h5").string(),
              "continuum.mesh.file=../../meshes/dcb_arms_coarse.geo", "coupling.overlap.band.half_thickness=1.0e-3",
              "coupling.overlap.band.width=5.0e-4", "coupling.overlap.band.to=0.027",
-             "dem.interface.bond.area=0.9e-4", "continuum.mesh.join={box: [[0.0275, -1, -1], [1, 1, 1]]}"},
+             "dem.interface.bond.area=0.9e-4", "continuum.mesh.join={box: [[0.026875, -1, -1], [1, 1, 1]]}",
+             // a band that follows the crack is not checkpointed
+             "coupling.overlap.band.follow={margin: 4.0e-3, ahead: 8.0e-3, behind: 1.5e-3, until: 0.046}",
+             "output={every: 1.0e-5, fields: []}"},
             dir_);
 
   read_case(cases + "fabric_impact/reduced.yaml",

@@ -1,0 +1,429 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#include "app/zone_move.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <tuple>
+#include <unordered_map>
+
+#include "common/error.hpp"
+#include "dem/crack_front.hpp"
+
+namespace arlequin::app {
+namespace {
+
+using Key = std::tuple<double, double, double>;
+Key key_of(const Vec3& x) { return {x.x, x.y, x.z}; }
+
+std::string exact(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", x);
+  return text;
+}
+
+// The DEM's cohesive interface, the bond set a following band measures its crack on (-1: none).
+int interface_set(const dem::DemModel& dem) {
+  for (std::size_t s = 0; s < dem.bond_sets().size(); ++s)
+    if (dem.bond_sets()[s]->name == "interface") return static_cast<int>(s);
+  return -1;
+}
+
+const BandFollow& follow_of(const Scene& scene) { return *scene.continuum->band_follow(); }
+
+dem::CrackFront crack_of(const Scene& scene) {
+  const BandFollow& f = follow_of(scene);
+  Vec3 along{}, across{};
+  along[f.along] = 1.0;
+  across[3 - f.axis - f.along] = 1.0;
+  return dem::measure_crack(*scene.dem.bond_sets()[interface_set(scene.dem)], scene.dem.particles, along, across, 8);
+}
+
+// What the case's own band gives the interface: its area (0: none given) and the join's box.
+struct CaseShares {
+  double area = 0.0;
+  std::optional<Box> join;
+  double lower = -INFINITY, upper = INFINITY;  // the packing region's extent along the band, m
+};
+
+CaseShares case_shares(const Scene& first) {
+  CaseShares out;
+  const BandFollow& f = follow_of(first);
+  const YAML::Node root = YAML::Load(first.resolved_case);
+  if (const YAML::Node area = root["dem"]["interface"]["bond"]["area"]) out.area = area.as<double>();
+  if (const YAML::Node join = root["continuum"]["mesh"]["join"]) {
+    const YAML::Node box = join["box"];
+    if (!box || join.size() != 1)
+      throw InputError(f.where + ": a following band moves the continuum's join with its end: expected continuum.mesh.join: "
+                                 "{box: [[x0, y0, z0], [x1, y1, z1]]}");
+    const auto corner = [&box](int k) { return Vec3{box[k][0].as<double>(), box[k][1].as<double>(), box[k][2].as<double>()}; };
+    out.join = Box{corner(0), corner(1)};
+  }
+  if (first.sample)
+    if (const auto* region = std::get_if<Box>(&first.sample->spec.region.shape()))
+      out.lower = region->lower[f.along], out.upper = region->upper[f.along];
+  return out;
+}
+
+double length_inside(double from, double to, const CaseShares& c) { return std::min(to, c.upper) - std::max(from, c.lower); }
+
+// Row r of `to`'s entry `name` becomes row map[r] of `from`'s where map[r] >= 0.
+void carry_rows(const StateArchive& from, StateArchive& to, const std::string& name, const std::vector<long>& map) {
+  const auto& src = from.entries().at(name);
+  StateArchive::Entry dst = to.entries().at(name);
+  if (src.kind != dst.kind || src.width != dst.width || dst.rows != map.size())
+    throw std::logic_error("zone move: '" + name + "' differs in layout between the two scenes");
+  const std::size_t row = dst.width * element_size(dst.kind);
+  for (std::size_t r = 0; r < map.size(); ++r)
+    if (map[r] >= 0) std::memcpy(dst.bytes.data() + r * row, src.bytes.data() + static_cast<std::size_t>(map[r]) * row, row);
+  to.put_entry(name, std::move(dst));
+}
+
+void carry_entry(const StateArchive& from, StateArchive& to, const std::string& name) { to.put_entry(name, from.entries().at(name)); }
+
+// The break records under `prefix` of the bonds both scenes have, renumbered; their count.
+std::size_t carry_events(const StateArchive& from, StateArchive& to, const std::string& prefix,
+                         const std::vector<std::vector<long>>& new_bond_of_old) {
+  const auto set = from.get<std::uint32_t>(prefix + "set"), bond = from.get<std::uint32_t>(prefix + "bond");
+  std::vector<long> kept;
+  std::vector<std::uint32_t> renumbered;
+  for (std::size_t k = 0; k < set.size(); ++k)
+    if (const long b = new_bond_of_old[set[k]][bond[k]]; b >= 0) kept.push_back(static_cast<long>(k)), renumbered.push_back(static_cast<std::uint32_t>(b));
+  for (const char* column : {"time", "stress", "energy", "mode_mix", "set", "criterion", "mode"}) {
+    StateArchive::Entry e = from.entries().at(prefix + column);
+    const std::size_t row = e.width * element_size(e.kind);
+    std::vector<std::byte> bytes(kept.size() * row);
+    for (std::size_t r = 0; r < kept.size(); ++r) std::memcpy(bytes.data() + r * row, e.bytes.data() + kept[r] * row, row);
+    e.bytes = std::move(bytes);
+    e.rows = kept.size();
+    to.put_entry(prefix + column, std::move(e));
+  }
+  to.put(prefix + "bond", renumbered);
+  return kept.size();
+}
+
+// The rotation of F (polar decomposition) as a quaternion, and the spin of dF/dt F^-1.
+std::pair<Quat, Vec3> rotation_and_spin(const Eigen::Matrix3d& F, const Eigen::Matrix3d& F_dot) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+  const Eigen::AngleAxisd turn(R);
+  const Eigen::Vector3d phi = turn.angle() * turn.axis();
+  const Eigen::Matrix3d L = F_dot * F.inverse();
+  const Eigen::Matrix3d W = 0.5 * (L - L.transpose());
+  return {from_rotation_vector({phi.x(), phi.y(), phi.z()}), Vec3{W(2, 1), W(0, 2), W(1, 0)}};
+}
+
+// sum over a of N_a(x_p) f_a for each point's shape values (f: 3 values a node).
+std::vector<Vec3> interpolate(const ContinuumPart::ShapeValues& rows, const std::vector<double>& f) {
+  std::vector<Vec3> out(rows.size());
+  for (std::size_t p = 0; p < rows.size(); ++p)
+    for (const auto& [a, N] : rows[p]) out[p] += N * Vec3{f[3 * a], f[3 * a + 1], f[3 * a + 2]};
+  return out;
+}
+
+// The new DEs' motion from the continuum before (its u and v) at their reference positions.
+void take_motion_from_continuum(const ContinuumPart& continuum, const std::vector<double>& u_nodes, const std::vector<double>& v_nodes,
+                                dem::ParticleSet& p, const std::vector<long>& old_of_new) {
+  constexpr double h = 1e-6;  // m, the central differences' half step
+  std::vector<std::uint32_t> added;
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < old_of_new.size(); ++i) {
+    if (old_of_new[i] >= 0) continue;
+    added.push_back(static_cast<std::uint32_t>(i));
+    const Vec3& X = p.reference[i];
+    points.push_back(X);
+    for (int k = 0; k < 3; ++k)
+      for (const double sign : {1.0, -1.0}) {
+        Vec3 Y = X;
+        Y[k] += sign * h;
+        points.push_back(Y);
+      }
+  }
+  if (added.empty()) return;
+  const auto rows = continuum.shape_values(points);
+  const std::vector<Vec3> u = interpolate(rows, u_nodes), v = interpolate(rows, v_nodes);
+  for (std::size_t a = 0; a < added.size(); ++a) {
+    const std::size_t i = added[a], at = 7 * a;
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity(), F_dot = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 du = (u[at + 1 + 2 * k] - u[at + 2 + 2 * k]) / (2.0 * h), dv = (v[at + 1 + 2 * k] - v[at + 2 + 2 * k]) / (2.0 * h);
+      for (int c = 0; c < 3; ++c) F(c, k) += du[c], F_dot(c, k) = dv[c];
+    }
+    const auto [q, spin] = rotation_and_spin(F, F_dot);
+    p.position[i] = p.reference[i] + u[at];
+    p.velocity[i] = v[at];
+    p.orientation[i] = q;
+    p.angular_velocity[i] = spin;
+  }
+}
+
+// A node new to the continuum (the pure-DEM zone's before): the motion of the DEs around it on
+// its side of the mid-plane, the value at X of the affine field fitted to the 16 nearest by least
+// squares (displacement and velocity).
+std::pair<Vec3, Vec3> motion_from_des(const dem::ParticleSet& p, const Vec3& X, std::uint8_t side, int axis, double center) {
+  constexpr std::size_t nearest = 16;
+  std::vector<std::pair<double, std::uint32_t>> found;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const bool below = p.reference[i][axis] < center;
+    if ((below && !(side & 1)) || (!below && !(side & 2))) continue;
+    found.emplace_back(norm2(p.reference[i] - X), static_cast<std::uint32_t>(i));
+  }
+  const std::size_t k = std::min(nearest, found.size());
+  if (k < 4) throw RunError("a moved zone's new continuum node has fewer than 4 DEs on its side to take its motion from");
+  std::partial_sort(found.begin(), found.begin() + static_cast<long>(k), found.end());
+  Eigen::MatrixXd A(k, 4), b(k, 6);
+  for (std::size_t r = 0; r < k; ++r) {
+    const std::uint32_t i = found[r].second;
+    const Vec3 d = p.reference[i] - X, u = p.position[i] - p.reference[i];
+    A.row(r) << 1.0, d.x, d.y, d.z;
+    b.row(r) << u.x, u.y, u.z, p.velocity[i].x, p.velocity[i].y, p.velocity[i].z;
+  }
+  const Eigen::MatrixXd fit = A.colPivHouseholderQr().solve(b);
+  return {Vec3{fit(0, 0), fit(0, 1), fit(0, 2)}, Vec3{fit(0, 3), fit(0, 4), fit(0, 5)}};
+}
+
+// The displacement of the nodes `refit` in equilibrium with the others held: the least strain
+// energy of the continuum as the new scene weighs it. One Newton step from u (its linear system
+// by conjugate gradients on those nodes' dofs, K times a direction by central differences of
+// f_int); the step's residual 1e-8 of the start's. Directions no weighted element stiffens stay
+// as they were.
+void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit, std::vector<double>& u) {
+  std::vector<std::size_t> dofs;
+  for (std::size_t a = 0; a < refit.size(); ++a)
+    if (refit[a])
+      for (int c = 0; c < 3; ++c) dofs.push_back(3 * a + c);
+  if (dofs.empty()) return;
+  std::vector<double> f(u.size()), shifted(u.size());
+  const auto restricted = [&dofs](const std::vector<double>& full) {
+    Eigen::VectorXd r(static_cast<long>(dofs.size()));
+    for (std::size_t k = 0; k < dofs.size(); ++k) r[static_cast<long>(k)] = full[dofs[k]];
+    return r;
+  };
+  const auto stiffness_times = [&](const Eigen::VectorXd& p) {
+    const double h = 1e-7 / std::max(p.cwiseAbs().maxCoeff(), 1e-300);  // m over the largest component
+    std::vector<double> plus(u.size()), minus(u.size());
+    shifted = u;
+    for (std::size_t k = 0; k < dofs.size(); ++k) shifted[dofs[k]] += h * p[static_cast<long>(k)];
+    continuum.internal_force(shifted, plus);
+    shifted = u;
+    for (std::size_t k = 0; k < dofs.size(); ++k) shifted[dofs[k]] -= h * p[static_cast<long>(k)];
+    continuum.internal_force(shifted, minus);
+    Eigen::VectorXd out = (restricted(plus) - restricted(minus)) / (2.0 * h);
+    return out;
+  };
+  continuum.internal_force(u, f);
+  const Eigen::VectorXd b = -restricted(f);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size()), r = b, p = r;
+  double rr = r.squaredNorm();
+  const double stop = 1e-16 * rr;
+  for (long it = 0; it < 2 * b.size() && rr > stop; ++it) {
+    const Eigen::VectorXd Ap = stiffness_times(p);
+    const double pAp = p.dot(Ap);
+    if (!(pAp > 0.0)) break;  // a direction nothing stiffens
+    const double alpha = rr / pAp;
+    x += alpha * p;
+    r -= alpha * Ap;
+    const double rr_next = r.squaredNorm();
+    p = r + (rr_next / rr) * p;
+    rr = rr_next;
+  }
+  for (std::size_t k = 0; k < dofs.size(); ++k) u[dofs[k]] += x[static_cast<long>(k)];
+}
+
+}  // namespace
+
+void check_band_follow(const Scene& scene) {
+  const BandFollow& f = follow_of(scene);
+  if (interface_set(scene.dem) < 0)
+    throw InputError(f.where + ": a band follows the crack of the DEM's interface, and this case has none (dem.interface)");
+  if (!scene.dem.bond_sets()[interface_set(scene.dem)]->has_strength())
+    throw InputError(f.where + ": the DEM's interface cannot fail, so there is no crack to follow");
+  if (scene.output.checkpoint_every > 0.0)
+    throw InputError(f.where + ": a band that follows a crack is built again as it moves, and its run is not checkpointed: "
+                               "remove output.checkpoint_every");
+  case_shares(scene);  // refuses a join it cannot move
+}
+
+std::optional<BandPlace> band_place(const Scene& scene) {
+  const BandFollow& f = follow_of(scene);
+  if (f.to >= f.until) return std::nullopt;
+  const dem::CrackFront crack = crack_of(scene);
+  if (!(crack.damage_front > f.to - f.margin)) return std::nullopt;  // also NaN: no damage yet
+  // Its end on a plane of element vertices, where a join that moves with it holds whole elements
+  // (a slit between the band's end and the join would be a crack ahead of the DEM's).
+  BandPlace place{f.from, std::min(scene.continuum->vertex_plane_from(f.along, crack.damage_front + f.ahead), f.until)};
+  // The band keeps its two end overlaps and a core between them (OverlapZone::band).
+  if (std::isfinite(crack.tip) && crack.tip - f.behind > f.from) place.from = std::min(crack.tip - f.behind, place.to - 4.0 * f.width);
+  place.from = std::max(place.from, f.from);
+  return place;
+}
+
+std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace place, ZoneMove& report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!current.model->accepts_set_state()) throw std::logic_error("move_zone between the substeps of a macro step");
+  const BandFollow& f0 = follow_of(first);
+  const CaseShares shares = case_shares(first);
+  report = ZoneMove{};
+  report.place = place;
+  report.energy_before = current.model->energies().total();
+
+  // The case again, the band moved.
+  SceneOptions options = current.built_with;
+  options.check_output_dir = false;
+  options.write_sample_cache = false;
+  const std::string origin = "the band following the crack (" + f0.where + ")";
+  const auto set = [&](const std::string& key, const std::string& value) { options.overrides.emplace_back(key + "=" + value, origin); };
+  set("coupling.overlap.band.from", exact(place.from));
+  set("coupling.overlap.band.to", exact(place.to));
+  if (shares.area > 0.0)
+    set("dem.interface.bond.area", exact(shares.area * length_inside(place.from, place.to, shares) / length_inside(f0.from, f0.to, shares)));
+  if (shares.join) {
+    Box join = *shares.join;
+    join.lower[f0.along] += place.to - f0.to;
+    char box[200];
+    std::snprintf(box, sizeof box, "{box: [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g]]}", join.lower.x, join.lower.y, join.lower.z,
+                  join.upper.x, join.upper.y, join.upper.z);
+    set("continuum.mesh.join", box);
+  }
+  set("time.dt", exact(current.dt));
+  options.crack_initial_tips.clear();
+  for (const Sensor& s : first.sensors) options.crack_initial_tips.push_back(s.crack.initial_tip);
+  // Built in place: its model refers to its own DEM and continuum.
+  std::unique_ptr<Scene> next(new Scene(build_scene(first.case_file, options)));
+  next->output = current.output;
+  next->steps = current.steps;
+
+  // Who is who: DEs by reference position, bonds by their DEs, nodes by position and side.
+  const dem::ParticleSet &po = current.dem.particles, &pn = next->dem.particles;
+  std::map<Key, long> old_de;
+  for (std::size_t i = 0; i < po.size(); ++i) old_de.emplace(key_of(po.reference[i]), static_cast<long>(i));
+  std::vector<long> old_of_new(pn.size(), -1);
+  for (std::size_t i = 0; i < pn.size(); ++i)
+    if (const auto it = old_de.find(key_of(pn.reference[i])); it != old_de.end()) old_of_new[i] = it->second, ++report.des_kept;
+  report.des = pn.size();
+  report.des_added = pn.size() - report.des_kept;
+  report.des_dropped = po.size() - report.des_kept;
+
+  const auto& sets_old = current.dem.bond_sets();
+  const auto& sets_new = next->dem.bond_sets();
+  if (sets_old.size() != sets_new.size()) throw std::logic_error("zone move: the scenes have different bond sets");
+  std::vector<std::vector<long>> bond_old_of_new(sets_new.size()), bond_new_of_old(sets_old.size());
+  for (std::size_t s = 0; s < sets_new.size(); ++s) {
+    const dem::BondSet &o = *sets_old[s], &n = *sets_new[s];
+    const auto pair_key = [&po](std::uint32_t i, std::uint32_t j) { return std::uint64_t{std::min(i, j)} * po.size() + std::max(i, j); };
+    std::unordered_map<std::uint64_t, long> old_bond;
+    for (std::size_t b = 0; b < o.size(); ++b) old_bond.emplace(pair_key(o.first()[b], o.second()[b]), static_cast<long>(b));
+    bond_old_of_new[s].assign(n.size(), -1);
+    bond_new_of_old[s].assign(o.size(), -1);
+    for (std::size_t b = 0; b < n.size(); ++b) {
+      const long i = old_of_new[n.first()[b]], j = old_of_new[n.second()[b]];
+      if (i < 0 || j < 0) continue;
+      if (const auto it = old_bond.find(pair_key(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j))); it != old_bond.end())
+        bond_old_of_new[s][b] = it->second, bond_new_of_old[s][it->second] = static_cast<long>(b);
+    }
+    for (std::size_t b = 0; b < o.size(); ++b) report.links_dropped_broken += bond_new_of_old[s][b] < 0 && o.broken()[b];
+  }
+
+  const ContinuumPart &co = *current.continuum, &cn = *next->continuum;
+  const auto& xo = co.node_positions();
+  const auto& xn = cn.node_positions();
+  const auto side_old = co.node_sides(f0.axis, f0.center), side_new = cn.node_sides(f0.axis, f0.center);
+  std::map<std::tuple<double, double, double, int>, long> old_node;
+  for (std::size_t a = 0; a < xo.size(); ++a) old_node.emplace(std::tuple{xo[a].x, xo[a].y, xo[a].z, int{side_old[a]}}, static_cast<long>(a));
+  std::vector<long> old_dof_of_new(3 * xn.size(), -1);
+  for (std::size_t a = 0; a < xn.size(); ++a) {
+    auto it = old_node.find(std::tuple{xn[a].x, xn[a].y, xn[a].z, int{side_new[a]}});
+    if (it == old_node.end()) it = old_node.find(std::tuple{xn[a].x, xn[a].y, xn[a].z, 3});  // joined before, apart now
+    if (it == old_node.end()) {
+      ++report.nodes_added;  // of the pure-DEM zone before
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) old_dof_of_new[3 * a + c] = 3 * it->second + c;
+  }
+
+  // The state, through the checkpoint archives: the new scene's own, overwritten by the old's.
+  StateArchive before, after;
+  current.model->save_state(before);
+  next->model->save_state(after);
+  for (const char* name : {"position", "velocity", "angular_velocity", "orientation"})
+    carry_rows(before, after, "dem/particles/" + std::string(name), old_of_new);
+  for (std::size_t s = 0; s < sets_new.size(); ++s) {
+    const std::string prefix = "dem/bonds/" + std::to_string(s) + "/";
+    for (const char* name : {"broken", "energy_record", "damage", "dissipated"})
+      if (after.has(prefix + name)) carry_rows(before, after, prefix + name, bond_old_of_new[s]);
+  }
+  const std::size_t breaks = carry_events(before, after, "dem/breaks/", bond_new_of_old);
+  const std::size_t held = after.has("dem/held_failures/time") ? carry_events(before, after, "dem/held_failures/", bond_new_of_old) : 0;
+  for (const char* name : {"dem/time", "dem/last_dt", "dem/steps", "dem/external_work", "dem/dissipated", "dem/fracture",
+                           "dem/energy_record_requested", "dem/energy_record_step", "continuum/time", "continuum/external_work",
+                           "continuum/dissipated", "coupling/work", "coupling/time", "coupling/steps"})
+    carry_entry(before, after, name);
+  for (const char* name : {"continuum/u", "continuum/v"}) carry_rows(before, after, name, old_dof_of_new);
+  {
+    // Where the DEM's weight falls (the zone left it) and where the continuum is new: the DEs'
+    // motion for the share the DEM carried, then the displacement relaxed to the continuum's
+    // equilibrium with the nodes around held.
+    auto u = after.get<double>("continuum/u"), v = after.get<double>("continuum/v");
+    std::vector<char> relaxed(xn.size(), 0);
+    for (std::size_t a = 0; a < xn.size(); ++a) {
+      const bool added = old_dof_of_new[3 * a] < 0;
+      const double dem_share = added ? 1.0 : co.dem_weight(xn[a]);
+      if (!added && !(dem_share > cn.dem_weight(xn[a]))) continue;
+      relaxed[a] = 1;
+      const auto [ua, va] = motion_from_des(po, xn[a], side_new[a], f0.axis, f0.center);
+      for (int c = 0; c < 3; ++c) {
+        u[3 * a + c] = dem_share * ua[c] + (1.0 - dem_share) * u[3 * a + c];
+        v[3 * a + c] = dem_share * va[c] + (1.0 - dem_share) * v[3 * a + c];
+      }
+      ++report.nodes_from_des;
+    }
+    relax_nodes(cn, relaxed, u);
+    after.put("continuum/u", u);
+    after.put("continuum/v", v);
+    // The coupled DEs those nodes interpolate go onto the continuum's field: the coupling keeps
+    // the displacement constraint G u = 0 as it finds it (the velocities are projected onto it).
+    std::vector<std::size_t> coupled;
+    std::vector<Vec3> points;
+    for (std::size_t i = 0; i < pn.size(); ++i)
+      if (const double w = cn.dem_weight(pn.reference[i]); w > 0.0 && w < 1.0 && old_of_new[i] >= 0)
+        coupled.push_back(i), points.push_back(pn.reference[i]);
+    const auto rows = cn.shape_values(points);
+    auto position = after.get<Vec3>("dem/particles/position");
+    for (std::size_t k = 0; k < coupled.size(); ++k)
+      if (std::any_of(rows[k].begin(), rows[k].end(), [&relaxed](const auto& e) { return relaxed[e.first] != 0; })) {
+        Vec3 x = points[k];
+        for (const auto& [a, N] : rows[k]) x += N * Vec3{u[3 * a], u[3 * a + 1], u[3 * a + 2]};
+        position[coupled[k]] = x;
+        ++report.des_onto_continuum;
+      }
+    after.put("dem/particles/position", position);
+  }
+  after.put("coupling/breaks_looked_at", static_cast<std::int64_t>(breaks));
+  after.put("coupling/held_looked_at", static_cast<std::int64_t>(held));
+  next->model->load_state(after);
+  take_motion_from_continuum(co, before.get<double>("continuum/u"), before.get<double>("continuum/v"), next->dem.particles, old_of_new);
+  next->model->resume_from_set_state();
+
+  // The crack sensors go on from the run's pre-crack tip, and count what the links left behind
+  // dissipated.
+  for (std::size_t k = 0; k < next->sensors.size(); ++k) {
+    const Sensor::Crack &was = current.sensors[k].crack;
+    Sensor::Crack& is = next->sensors[k].crack;
+    if (next->sensors[k].kind != Sensor::Kind::crack) continue;
+    const auto dissipated = [&is](const Scene& scene) {
+      return dem::measure_crack(*scene.dem.bond_sets()[is.bond_set], scene.dem.particles, is.axis, is.across, is.bins).dissipated;
+    };
+    is.dissipated_left = was.dissipated_left + dissipated(current) - dissipated(*next);
+  }
+  report.energy_after = next->model->energies().total();
+  report.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return next;
+}
+
+}  // namespace arlequin::app

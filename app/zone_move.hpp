@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// A DEM zone that follows a crack: the band of coupling.overlap.band.follow moves along, ahead of
+// the DEM interface's damage front, and the scene is built again around it with the state carried
+// over (docs/theory.md#moving-zone).
+//
+// Contract
+//  - band_place(scene): where the band goes now, from the crack of the DEM's bond set "interface"
+//    measured now (dem/crack_front.hpp: along the band, eight strips across it). nullopt while
+//    the damage front stays `margin` or more behind the band's `to` (or has not started), and
+//    once `to` is at `until`; else to = min(front + ahead, until) and from = max(from, tip -
+//    behind), from kept where the band would be too short for its two overlaps and a core.
+//  - move_zone(first, current, place): the case of `first` (the run's scene as built) built again
+//    with the run's options and these overrides: the band's from and to; the interface's `area`
+//    scaled by the band's length inside the packing's region (the area per length of the case's
+//    band); continuum.mesh.join's box with its lower end along the band moved as `to` moved; and
+//    time.dt the run's step (refused, as any case, if above the new scene's critical step). Then
+//    `current`'s state is carried over through the models' checkpoint archives:
+//      * DEs with the same reference position: their motion (position, velocity, orientation,
+//        spin); bonds and cohesive links between two such DEs: broken flags, damage and
+//        dissipation, with the break records of those bonds; continuum nodes with the same
+//        reference position and side of the band's mid-plane (ContinuumPart::node_sides: a
+//        node joined before is both sides' after): displacement and velocity; the running sums
+//        (time, step, external works, dissipation, fracture, the coupling's work);
+//      * DEs new to the zone: the continuum's motion at their reference position X, the
+//        displacement and velocity interpolated there, the orientation the rotation of F = I +
+//        du/dX (polar decomposition) and the spin the axial vector of dF/dt F^-1 (central
+//        differences over 1e-6 m);
+//      * continuum nodes where the DEM's weight alpha_d falls (the zone left them behind) and
+//        those new to the continuum (of tetrahedra the pure-DEM zone left out before, alpha_d = 1
+//        there): first alpha_d u_DEM + (1 - alpha_d) u, alpha_d the weight before and u_DEM the
+//        affine field fitted by least squares to the 16 nearest DEs on their side of the
+//        mid-plane, at the node (displacement and velocity alike); then their displacement
+//        relaxed to the continuum's equilibrium with the other nodes held (the least strain
+//        energy: one Newton step by conjugate gradients). The coupled DEs those nodes
+//        interpolate go onto the continuum's field: the coupling keeps the displacement
+//        constraint G u = 0 as it finds it (SceneModel::displacement_residual);
+//      * then the forces and the coupling's constraint of that state
+//        (SceneModel::resume_from_set_state). The crack sensors keep the pre-crack tip of the
+//        scene as first built, and the energy dissipated by links left behind.
+//    Only between two steps where current.model->accepts_set_state(). InputError (naming the
+//    follow section) where the case cannot move: no interface, a join that is not a box.
+//  - The move changes the total energy (DEs and links dropped behind and added ahead, weights
+//    moved): ZoneMove::energy_jump, which the run's energy balance books as its own term. A move
+//    of `to` alone changes it by 1e-3 of the total or less; a move of `from` hands the DEM's
+//    wake to a continuum that does not bend as it did, a jump of a few percent that rings
+//    through the arms (docs/decisions.md#d56).
+#pragma once
+#include <memory>
+#include <optional>
+
+#include "app/scene.hpp"
+
+namespace arlequin::app {
+
+struct BandPlace {
+  double from = 0.0, to = 0.0;  // m, along the band
+};
+
+struct ZoneMove {
+  BandPlace place;
+  std::size_t des = 0, des_kept = 0, des_added = 0, des_dropped = 0;
+  std::size_t nodes_added = 0;            // continuum nodes of the pure-DEM zone before
+  std::size_t nodes_from_des = 0;         // nodes whose motion the DEs gave (those added among them)
+  std::size_t des_onto_continuum = 0;     // coupled DEs put on the continuum's field after that
+  std::size_t links_dropped_broken = 0;  // bonds left behind broken (with their break records)
+  double energy_before = 0.0, energy_after = 0.0;  // J, the scene's total energy
+  double energy_jump() const { return energy_after - energy_before; }
+  double setup_seconds = 0.0;  // building the new scene and carrying the state
+};
+
+std::optional<BandPlace> band_place(const Scene& scene);
+
+std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace place, ZoneMove& report);
+
+// build_scene's check of a case whose band follows a crack (InputError at the follow section).
+void check_band_follow(const Scene& scene);
+
+}  // namespace arlequin::app
