@@ -663,7 +663,15 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     const std::size_t breaks_before = model->breaks().size();
     if (!first_break_time && breaks_before > 0) first_break_time = model->breaks().front().time;
     ZoneMove move;
-    std::unique_ptr<Scene> next = move_zone(built, *scene, place, move);
+    std::unique_ptr<Scene> next;
+    try {
+      next = move_zone(built, *scene, place, move);
+    } catch (const InputError& e) {  // the moved band's case refused (a step above its critical one)
+      std::ostringstream at;
+      at << "step " << steps_done << " (t = " << current_time() << " s): the band could not move to [" << place.from << ", " << place.to
+         << "] m: " << e.what();
+      throw RunError(at.str());
+    }
     if (profile) model->set_profile(nullptr), next->dem.set_profile(profile);
     outputs.follow(*next);
     moved = std::move(next);

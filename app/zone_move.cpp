@@ -177,14 +177,20 @@ std::pair<Vec3, Vec3> motion_from_des(const dem::ParticleSet& p, const Vec3& X, 
   const std::size_t k = std::min(nearest, found.size());
   if (k < 4) throw RunError("a moved zone's new continuum node has fewer than 4 DEs on its side to take its motion from");
   std::partial_sort(found.begin(), found.begin() + static_cast<long>(k), found.end());
-  Eigen::MatrixXd A(k, 4), b(k, 6);
+  // The normal equations, fixed-size: no dynamic Eigen matrix is instantiated here, whose
+  // alignment would differ from the one a shared library built apart (gmsh) expects of its own.
+  Eigen::Matrix4d normal = Eigen::Matrix4d::Zero();
+  Eigen::Matrix<double, 4, 6> rhs = Eigen::Matrix<double, 4, 6>::Zero();
   for (std::size_t r = 0; r < k; ++r) {
     const std::uint32_t i = found[r].second;
     const Vec3 d = p.reference[i] - X, u = p.position[i] - p.reference[i];
-    A.row(r) << 1.0, d.x, d.y, d.z;
-    b.row(r) << u.x, u.y, u.z, p.velocity[i].x, p.velocity[i].y, p.velocity[i].z;
+    const Eigen::Vector4d a(1.0, d.x, d.y, d.z);
+    Eigen::Matrix<double, 1, 6> b;
+    b << u.x, u.y, u.z, p.velocity[i].x, p.velocity[i].y, p.velocity[i].z;
+    normal += a * a.transpose();
+    rhs += a * b;
   }
-  const Eigen::MatrixXd fit = A.colPivHouseholderQr().solve(b);
+  const Eigen::Matrix<double, 4, 6> fit = normal.colPivHouseholderQr().solve(rhs);
   return {Vec3{fit(0, 0), fit(0, 1), fit(0, 2)}, Vec3{fit(0, 3), fit(0, 4), fit(0, 5)}};
 }
 
@@ -199,41 +205,42 @@ void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit,
     if (refit[a])
       for (int c = 0; c < 3; ++c) dofs.push_back(3 * a + c);
   if (dofs.empty()) return;
-  std::vector<double> f(u.size()), shifted(u.size());
-  const auto restricted = [&dofs](const std::vector<double>& full) {
-    Eigen::VectorXd r(static_cast<long>(dofs.size()));
-    for (std::size_t k = 0; k < dofs.size(); ++k) r[static_cast<long>(k)] = full[dofs[k]];
-    return r;
+  const std::size_t n = dofs.size();
+  const auto dot = [n](const std::vector<double>& a, const std::vector<double>& b) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < n; ++k) sum += a[k] * b[k];
+    return sum;
   };
-  const auto stiffness_times = [&](const Eigen::VectorXd& p) {
-    const double h = 1e-7 / std::max(p.cwiseAbs().maxCoeff(), 1e-300);  // m over the largest component
-    std::vector<double> plus(u.size()), minus(u.size());
-    shifted = u;
-    for (std::size_t k = 0; k < dofs.size(); ++k) shifted[dofs[k]] += h * p[static_cast<long>(k)];
-    continuum.internal_force(shifted, plus);
-    shifted = u;
-    for (std::size_t k = 0; k < dofs.size(); ++k) shifted[dofs[k]] -= h * p[static_cast<long>(k)];
-    continuum.internal_force(shifted, minus);
-    Eigen::VectorXd out = (restricted(plus) - restricted(minus)) / (2.0 * h);
-    return out;
+  std::vector<double> f(u.size()), plus(u.size()), minus(u.size()), shifted(u.size());
+  // K p on the dofs, by central differences of f_int over 1e-7 m along p's largest component.
+  const auto stiffness_times = [&](const std::vector<double>& p, std::vector<double>& out) {
+    double largest = 0.0;
+    for (double x : p) largest = std::max(largest, std::abs(x));
+    const double h = 1e-7 / std::max(largest, 1e-300);
+    for (const double sign : {1.0, -1.0}) {
+      shifted = u;
+      for (std::size_t k = 0; k < n; ++k) shifted[dofs[k]] += sign * h * p[k];
+      continuum.internal_force(shifted, sign > 0.0 ? plus : minus);
+    }
+    for (std::size_t k = 0; k < n; ++k) out[k] = (plus[dofs[k]] - minus[dofs[k]]) / (2.0 * h);
   };
   continuum.internal_force(u, f);
-  const Eigen::VectorXd b = -restricted(f);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size()), r = b, p = r;
-  double rr = r.squaredNorm();
+  std::vector<double> x(n, 0.0), r(n), p(n), Ap(n);
+  for (std::size_t k = 0; k < n; ++k) r[k] = -f[dofs[k]];
+  p = r;
+  double rr = dot(r, r);
   const double stop = 1e-16 * rr;
-  for (long it = 0; it < 2 * b.size() && rr > stop; ++it) {
-    const Eigen::VectorXd Ap = stiffness_times(p);
-    const double pAp = p.dot(Ap);
+  for (std::size_t it = 0; it < 2 * n && rr > stop; ++it) {
+    stiffness_times(p, Ap);
+    const double pAp = dot(p, Ap);
     if (!(pAp > 0.0)) break;  // a direction nothing stiffens
     const double alpha = rr / pAp;
-    x += alpha * p;
-    r -= alpha * Ap;
-    const double rr_next = r.squaredNorm();
-    p = r + (rr_next / rr) * p;
+    for (std::size_t k = 0; k < n; ++k) x[k] += alpha * p[k], r[k] -= alpha * Ap[k];
+    const double rr_next = dot(r, r);
+    for (std::size_t k = 0; k < n; ++k) p[k] = r[k] + (rr_next / rr) * p[k];
     rr = rr_next;
   }
-  for (std::size_t k = 0; k < dofs.size(); ++k) u[dofs[k]] += x[static_cast<long>(k)];
+  for (std::size_t k = 0; k < n; ++k) u[dofs[k]] += x[k];
 }
 
 }  // namespace
