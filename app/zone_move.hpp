@@ -41,7 +41,7 @@
 //    follow section) where the case cannot move: no interface, a join that is not a box.
 //  - The move changes the total energy (DEs and links dropped behind and added ahead, weights
 //    moved): ZoneMove::energy_jump, which the run's energy balance books as its own term. A move
-//    of `to` alone changes it by 1e-3 of the total or less; a move of `from` hands the DEM's
+//    of `to` alone changes it by a few 1e-3 of the total or less; a move of `from` hands the DEM's
 //    wake to a continuum that does not bend as it did, a jump of a few percent that rings
 //    through the arms (docs/decisions.md#d56).
 #pragma once
