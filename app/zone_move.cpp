@@ -73,16 +73,20 @@ CaseShares case_shares(const Scene& first) {
 
 double length_inside(double from, double to, const CaseShares& c) { return std::min(to, c.upper) - std::max(from, c.lower); }
 
+// `out` with its row r replaced by row map[r] of `src` where map[r] >= 0 (same layout).
+StateArchive::Entry rows_from(const StateArchive::Entry& src, const std::vector<long>& map, StateArchive::Entry out,
+                              const std::string& name) {
+  if (src.kind != out.kind || src.width != out.width || out.rows != map.size())
+    throw std::logic_error("zone move: '" + name + "' differs in layout between the two scenes");
+  const std::size_t row = out.width * element_size(out.kind);
+  for (std::size_t r = 0; r < map.size(); ++r)
+    if (map[r] >= 0) std::memcpy(out.bytes.data() + r * row, src.bytes.data() + static_cast<std::size_t>(map[r]) * row, row);
+  return out;
+}
+
 // Row r of `to`'s entry `name` becomes row map[r] of `from`'s where map[r] >= 0.
 void carry_rows(const StateArchive& from, StateArchive& to, const std::string& name, const std::vector<long>& map) {
-  const auto& src = from.entries().at(name);
-  StateArchive::Entry dst = to.entries().at(name);
-  if (src.kind != dst.kind || src.width != dst.width || dst.rows != map.size())
-    throw std::logic_error("zone move: '" + name + "' differs in layout between the two scenes");
-  const std::size_t row = dst.width * element_size(dst.kind);
-  for (std::size_t r = 0; r < map.size(); ++r)
-    if (map[r] >= 0) std::memcpy(dst.bytes.data() + r * row, src.bytes.data() + static_cast<std::size_t>(map[r]) * row, row);
-  to.put_entry(name, std::move(dst));
+  to.put_entry(name, rows_from(from.entries().at(name), map, to.entries().at(name), name));
 }
 
 void carry_entry(const StateArchive& from, StateArchive& to, const std::string& name) { to.put_entry(name, from.entries().at(name)); }
@@ -96,13 +100,9 @@ std::size_t carry_events(const StateArchive& from, StateArchive& to, const std::
   for (std::size_t k = 0; k < set.size(); ++k)
     if (const long b = new_bond_of_old[set[k]][bond[k]]; b >= 0) kept.push_back(static_cast<long>(k)), renumbered.push_back(static_cast<std::uint32_t>(b));
   for (const char* column : {"time", "stress", "energy", "mode_mix", "set", "criterion", "mode"}) {
-    StateArchive::Entry e = from.entries().at(prefix + column);
-    const std::size_t row = e.width * element_size(e.kind);
-    std::vector<std::byte> bytes(kept.size() * row);
-    for (std::size_t r = 0; r < kept.size(); ++r) std::memcpy(bytes.data() + r * row, e.bytes.data() + kept[r] * row, row);
-    e.bytes = std::move(bytes);
-    e.rows = kept.size();
-    to.put_entry(prefix + column, std::move(e));
+    const StateArchive::Entry& src = from.entries().at(prefix + column);
+    StateArchive::Entry out{src.kind, src.width, kept.size(), std::vector<std::byte>(kept.size() * src.width * element_size(src.kind))};
+    to.put_entry(prefix + column, rows_from(src, kept, std::move(out), prefix + column));
   }
   to.put(prefix + "bond", renumbered);
   return kept.size();
@@ -277,7 +277,6 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
   const BandFollow& f0 = follow_of(first);
   const CaseShares shares = case_shares(first);
   report = ZoneMove{};
-  report.place = place;
   report.energy_before = current.model->energies().total();
 
   // The case again, the band moved.

@@ -57,7 +57,6 @@ struct BandPlace {
 };
 
 struct ZoneMove {
-  BandPlace place;
   std::size_t des = 0, des_kept = 0, des_added = 0, des_dropped = 0;
   std::size_t nodes_added = 0;            // continuum nodes of the pure-DEM zone before
   std::size_t nodes_from_des = 0;         // nodes whose motion the DEs gave (those added among them)
