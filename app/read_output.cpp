@@ -122,9 +122,7 @@ void read_sensors(CaseNode root, Scene& scene) {
       sensor.kind = Sensor::Kind::crack;
       sensor.component = 0;
       const std::string set_name = s.string_or("bonds", "interface");
-      const auto& sets = scene.dem.bond_sets();
-      for (std::size_t k = 0; k < sets.size(); ++k)
-        if (sets[k]->name == set_name) sensor.crack.bond_set = int(k);
+      sensor.crack.bond_set = scene.dem.bond_set_index(set_name);
       if (sensor.crack.bond_set < 0) s.fail("bonds", "no bond set named '" + set_name + "'");
       const std::string quantity = s.choice_or("quantity", "tip", crack_quantities);
       sensor.crack.quantity = Sensor::CrackQuantity(
@@ -136,7 +134,7 @@ void read_sensors(CaseNode root, Scene& scene) {
         *target = normalized(v);
       }
       sensor.crack.bins = int(s.integer_or("bins", 8, Range::at_least(1)));
-      const auto& set = *sets[sensor.crack.bond_set];
+      const auto& set = *scene.dem.bond_sets()[sensor.crack.bond_set];
       const auto& tips = scene.built_with.crack_initial_tips;
       sensor.crack.initial_tip = tips.empty() ? dem::measure_crack(set, scene.dem.particles, sensor.crack.axis, sensor.crack.across,
                                                                    sensor.crack.bins).tip

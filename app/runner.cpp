@@ -690,7 +690,6 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     row["particles_dropped"] = move.des_dropped;
     row["continuum_nodes_added"] = move.nodes_added;
     row["continuum_nodes_from_des"] = move.nodes_from_des;
-    row["particles_onto_continuum"] = move.des_onto_continuum;
     row["displacement_residual"] = scene->model->displacement_residual();
     row["broken_bonds_left_behind"] = move.links_dropped_broken;
     row["energy_jump"] = move.energy_jump();

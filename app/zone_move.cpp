@@ -29,11 +29,7 @@ std::string exact(double x) {
 }
 
 // The DEM's cohesive interface, the bond set a following band measures its crack on (-1: none).
-int interface_set(const dem::DemModel& dem) {
-  for (std::size_t s = 0; s < dem.bond_sets().size(); ++s)
-    if (dem.bond_sets()[s]->name == "interface") return static_cast<int>(s);
-  return -1;
-}
+int interface_set(const dem::DemModel& dem) { return dem.bond_set_index("interface"); }
 
 const BandFollow& follow_of(const Scene& scene) { return *scene.continuum->band_follow(); }
 
@@ -374,13 +370,18 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
   {
     // Where the DEM's weight falls (the zone left it) and where the continuum is new: the DEs'
     // motion for the share the DEM carried, then the displacement relaxed to the continuum's
-    // equilibrium with the nodes around held.
+    // equilibrium with the nodes around held. Also the nodes of the elements the band's new start
+    // overlap reaches that lay in the DEM-only zone: the continuum weighed them as nothing, so
+    // their field is no continuum's own, and the overlap now weighs it.
     auto u = after.get<double>("continuum/u"), v = after.get<double>("continuum/v");
+    const bool start_moved = place.from > follow_of(current).from;
+    const double start_reach = cn.vertex_plane_from(f0.along, place.from + f0.width);
     std::vector<char> relaxed(xn.size(), 0);
     for (std::size_t a = 0; a < xn.size(); ++a) {
       const bool added = old_dof_of_new[3 * a] < 0;
       const double dem_share = added ? 1.0 : co.dem_weight(xn[a]);
-      if (!added && !(dem_share > cn.dem_weight(xn[a]))) continue;
+      const bool reached = start_moved && dem_share >= 1.0 && xn[a][f0.along] <= start_reach;
+      if (!added && !reached && !(dem_share > cn.dem_weight(xn[a]))) continue;
       relaxed[a] = 1;
       const auto [ua, va] = motion_from_des(po, xn[a], side_new[a], f0.axis, f0.center);
       for (int c = 0; c < 3; ++c) {
@@ -392,23 +393,10 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
     relax_nodes(cn, relaxed, u);
     after.put("continuum/u", u);
     after.put("continuum/v", v);
-    // The coupled DEs those nodes interpolate go onto the continuum's field: the coupling keeps
-    // the displacement constraint G u = 0 as it finds it (the velocities are projected onto it).
-    std::vector<std::size_t> coupled;
-    std::vector<Vec3> points;
-    for (std::size_t i = 0; i < pn.size(); ++i)
-      if (const double w = cn.dem_weight(pn.reference[i]); w > 0.0 && w < 1.0 && old_of_new[i] >= 0)
-        coupled.push_back(i), points.push_back(pn.reference[i]);
-    const auto rows = cn.shape_values(points);
-    auto position = after.get<Vec3>("dem/particles/position");
-    for (std::size_t k = 0; k < coupled.size(); ++k)
-      if (std::any_of(rows[k].begin(), rows[k].end(), [&relaxed](const auto& e) { return relaxed[e.first] != 0; })) {
-        Vec3 x = points[k];
-        for (const auto& [a, N] : rows[k]) x += N * Vec3{u[3 * a], u[3 * a + 1], u[3 * a + 2]};
-        position[coupled[k]] = x;
-        ++report.des_onto_continuum;
-      }
-    after.put("dem/particles/position", position);
+    // The coupled DEs stay where they are: the coupling ties velocities and keeps G u as it finds
+    // it, the DEs' offset from the continuum's field included (SceneModel::displacement_residual).
+    // Put onto that field, they would lose their own fluctuation about it at the cost of their
+    // bonds' energy (docs/decisions.md#d56).
   }
   after.put("coupling/breaks_looked_at", static_cast<std::int64_t>(breaks));
   after.put("coupling/held_looked_at", static_cast<std::int64_t>(held));

@@ -47,6 +47,11 @@ int DemModel::group_index(const std::string& name) const {
   return it == group_names_.end() ? -1 : static_cast<int>(it - group_names_.begin());
 }
 
+int DemModel::bond_set_index(const std::string& name) const {
+  const auto it = std::find_if(bond_sets_.begin(), bond_sets_.end(), [&name](const auto& set) { return set->name == name; });
+  return it == bond_sets_.end() ? -1 : static_cast<int>(it - bond_sets_.begin());
+}
+
 BondSet& DemModel::add_bond_set(std::unique_ptr<BondSet> set) {
   bond_sets_.push_back(std::move(set));
   return *bond_sets_.back();

@@ -54,6 +54,7 @@ class DemModel {
 
   BondSet& add_bond_set(std::unique_ptr<BondSet> set);
   const std::vector<std::unique_ptr<BondSet>>& bond_sets() const { return bond_sets_; }
+  int bond_set_index(const std::string& name) const;  // -1 if unknown
   void set_contact(std::unique_ptr<ContactLaw> law, double skin);
   bool has_contact() const { return contact_ != nullptr; }
   const NeighbourList* neighbours() const { return neighbours_ ? &*neighbours_ : nullptr; }

@@ -104,6 +104,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"missing_required", 2, "time: {dt: auto}", "", {"case.yaml:2", "time", "missing required key 'end'"}},
         BadInput{"r_mu_out_of_range", 6, "  bond: {law: beam, E_mu: 2.0e11, r_mu: 5}", "",
                  {"case.yaml:6", "dem.bond.r_mu"}},
+        BadInput{"unknown_crack_bond_set", 14, "  - {name: a, type: crack, bonds: interfce}", "",
+                 {"case.yaml:14", "sensors[0].bonds", "no bond set named 'interfce'"}},
         BadInput{"unknown_sensor_type", 14, "  - {name: F, type: forse, group: right}", "",
                  {"case.yaml:14", "sensors[0].type", "did you mean 'force'"}},
         BadInput{"rdef_compaction_with_laguerre_volumes", 6,
