@@ -159,9 +159,10 @@ void take_motion_from_continuum(const ContinuumPart& continuum, const std::vecto
   }
 }
 
-// A node new to the continuum (the pure-DEM zone's before): the motion of the DEs around it on
-// its side of the mid-plane, the value at X of the affine field fitted to the 16 nearest by least
-// squares (displacement and velocity).
+// A continuum node whose motion the DEs give (one the band leaves, one new to the continuum, one
+// the new start overlap reaches): the motion of the DEs around it on its side of the mid-plane,
+// the value at X of the affine field fitted to the 16 nearest by least squares (displacement and
+// velocity).
 std::pair<Vec3, Vec3> motion_from_des(const dem::ParticleSet& p, const Vec3& X, std::uint8_t side, int axis, double center) {
   constexpr std::size_t nearest = 16;
   std::vector<std::pair<double, std::uint32_t>> found;
