@@ -125,6 +125,8 @@ constexpr KeyDoc follow_keys[] = {
     {"ahead", KeyType::number, "m", Range::positive(), "", "its new to: this beyond the damage front (at most until; more than margin)"},
     {"behind", KeyType::number, "m", Range::positive(), "(from stays)", "its new from: this behind the crack tip (never back; moving it disturbs the run, docs/decisions.md#d56)"},
     {"until", KeyType::number, "m", Range::any(), "", "the furthest to: the band's to with the whole interface in it"},
+    {"settle_time", KeyType::number, "s", Range::non_negative(), "4e-05", "after a move of from: how long the DEs around the new start are kinetically damped (0: not)"},
+    {"settle_length", KeyType::number, "m", Range::positive(), "0.006", "after a move of from: the damped DEs reach this beyond the new from"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -330,7 +332,8 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
       CaseNode f = band.child("follow");
       follow = BandFollow{f.number("margin", Range::positive(), "m"), f.number("ahead", Range::positive(), "m"),
                           f.number_or("behind", INFINITY, Range::positive(), "m"), f.number("until", Range::any(), "m"), axis, along, center, from, to,
-                          width, f.where()};
+                          width, f.number_or("settle_time", 4.0e-5, Range::non_negative(), "s"),
+                          f.number_or("settle_length", 6.0e-3, Range::positive(), "m"), f.where()};
       if (follow->ahead <= follow->margin)
         f.fail("ahead", "expected more than margin (" + std::to_string(follow->margin) + " m): the band would move again at once");
       if (follow->until < to) f.fail("until", "expected the band's furthest end, at or beyond its to (" + std::to_string(to) + " m)");
@@ -419,6 +422,7 @@ class Coupled final : public SceneModel {
   bool accepts_set_state() const override { return model_->opens_macro_step(); }
   void resume_from_set_state() override { model_->resume_from_set_state(); }
   double displacement_residual() const override { return model_->displacement_residual(); }
+  double arrest(std::span<const std::uint32_t> ids) override { return model_->arrest(ids); }
   std::optional<OverlapDamageReport> damage_in_overlap() override {
     const auto damage = model_->damage_in_overlap();
     if (!damage) return std::nullopt;
@@ -518,6 +522,7 @@ class Part final : public ContinuumPart {
     }
     return side;
   }
+  bool prescribed(std::size_t dof) const override { return solver_->is_fixed(static_cast<int>(dof)); }
   void internal_force(const std::vector<double>& u, std::vector<double>& f) const override { solver_->internal_force(u, f); }
   ShapeValues shape_values(const std::vector<Vec3>& points) const override {
     ShapeValues rows(points.size());

@@ -51,6 +51,10 @@ struct BandFollow {
   double until = 0.0;   // m: the furthest `to`
   int axis = 2, along = 0;                                 // the band's (0, 1, 2)
   double center = 0.0, from = 0.0, to = 0.0, width = 0.0;  // m, the band as read
+  // After a move of `from`, the DEs from it to settle_length beyond it are kinetically damped
+  // over settle_time (app/zone_move.hpp: BandSettling).
+  double settle_time = 0.0;    // s
+  double settle_length = 0.0;  // m
   std::string where;                         // file:line of the follow section
 };
 
@@ -79,6 +83,7 @@ class ContinuumPart {
   // where a band may end so that a join from there holds whole elements (+inf: none).
   virtual double vertex_plane_from(int axis, double x) const = 0;
   virtual std::vector<std::uint8_t> node_sides(int axis, double center) const = 0;
+  virtual bool prescribed(std::size_t dof) const = 0;  // whether a support or a driven strip sets this dof
   using ShapeValues = std::vector<std::vector<std::pair<int, double>>>;
   virtual ShapeValues shape_values(const std::vector<Vec3>& points) const = 0;
   // f_int(u) (3 values a node) of the continuum as weighted: K u for small strains.

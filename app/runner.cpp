@@ -659,7 +659,19 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
   std::size_t breaks_left_behind = 0;
   std::optional<double> first_break_time;
   double zone_energy_jumps = 0.0;
+  // After a move of the start, the settling of the DEs around it; its row in zone_moves.
+  BandSettling settling;
+  std::size_t settling_row = 0;
+  double settling_dissipated = 0.0;  // J, by the settlings before the present one
+  const auto record_settling = [&] {
+    if (settling.steps_done() == 0) return;
+    Json& row = zone_moves[settling_row];
+    row["settling_steps"] = settling.steps_done();
+    row["settling_particles"] = settling.particles();
+    row["settling_dissipated"] = settling.dissipated();
+  };
   const auto move_zone_to = [&](BandPlace place) {
+    const bool start_moves = place.from > scene->continuum->band_follow()->from;
     const std::size_t breaks_before = model->breaks().size();
     if (!first_break_time && breaks_before > 0) first_break_time = model->breaks().front().time;
     ZoneMove move;
@@ -696,6 +708,14 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     row["energy_before"] = move.energy_before;
     row["seconds"] = move.setup_seconds;
     zone_moves.push_back(row);
+    if (start_moves && scene->continuum->band_follow()->settle_time > 0.0) {
+      record_settling();
+      settling_dissipated += settling.dissipated();
+      settling.start(*scene);
+      settling_row = zone_moves.size() - 1;
+    } else {
+      settling.carry_to(*scene);
+    }
     std::fprintf(stderr,
                  "  the band moved at step %ld (t = %.6g s) to [%.6g, %.6g] m: %zu DEs (%zu added, %zu dropped), %zu continuum nodes "
                  "added, energy %+.3g J of %.3g J, %.2f s\n",
@@ -722,6 +742,10 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
       if (output_after(n)) model->record_energies_in_next_step();  // the step's force pass gives the row's bond energies
       step_model();
       ++steps_done;
+      if (settling.active()) {
+        settling.after_step(*model, *scene->model);
+        if (!settling.active()) record_settling();
+      }
       if (profile) profile->count_step();
       model->check_finite();  // the DEM times it
       {
@@ -803,6 +827,8 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
   if (follows) {
     summary["zone_moves"] = zone_moves;
     summary["zone_energy_jumps"] = zone_energy_jumps;
+    record_settling();
+    summary["zone_settling_dissipated"] = settling_dissipated + settling.dissipated();
   }
   if (!model->bond_sets().empty()) {
     Json& bonds = counts["bonds"];

@@ -5,6 +5,7 @@
 #pragma once
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -70,6 +71,11 @@ class SceneModel {
   // |G_d u_d + G_c u_c| / |G_d u_d| (coupling/coupled_model.hpp), 0 uncoupled: how far a state
   // set from outside is off the displacement constraint, which the coupling keeps as it finds it.
   virtual double displacement_residual() const { return 0.0; }
+  // Kinetic damping where accepts_set_state() (a moved zone's settling, app/zone_move.hpp): the
+  // DEs `ids` stop and the velocities go back onto the coupling's constraint; the energy this
+  // takes out is booked (coupling/coupled_model.hpp: CoupledModel::arrest). Returns the DEs' part
+  // of it, J.
+  virtual double arrest(std::span<const std::uint32_t> ids) { throw std::logic_error("only a coupled scene's zone settles"); }
   virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)
   virtual void describe(Json& counts) const {}       // summary.json counts of its own
 };

@@ -191,16 +191,17 @@ std::pair<Vec3, Vec3> motion_from_des(const dem::ParticleSet& p, const Vec3& X, 
   return {Vec3{fit(0, 0), fit(0, 1), fit(0, 2)}, Vec3{fit(0, 3), fit(0, 4), fit(0, 5)}};
 }
 
-// The displacement of the nodes `refit` in equilibrium with the others held: the least strain
-// energy of the continuum as the new scene weighs it. One Newton step from u (its linear system
-// by conjugate gradients on those nodes' dofs, K times a direction by central differences of
-// f_int); the step's residual 1e-8 of the start's. Directions no weighted element stiffens stay
-// as they were.
+// The displacement of the nodes `refit` in equilibrium with the others held (and the dofs a
+// support or driven strip sets): the least strain energy of the continuum as the new scene
+// weighs it. One Newton step from u (its linear system by conjugate gradients on those nodes'
+// dofs, K times a direction by central differences of f_int); the step's residual 1e-8 of the
+// start's. Directions no weighted element stiffens stay as they were.
 void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit, std::vector<double>& u) {
   std::vector<std::size_t> dofs;
   for (std::size_t a = 0; a < refit.size(); ++a)
     if (refit[a])
-      for (int c = 0; c < 3; ++c) dofs.push_back(3 * a + c);
+      for (std::size_t c = 0; c < 3; ++c)
+        if (!continuum.prescribed(3 * a + c)) dofs.push_back(3 * a + c);
   if (dofs.empty()) return;
   const std::size_t n = dofs.size();
   const auto dot = [n](const std::vector<double>& a, const std::vector<double>& b) {
@@ -266,6 +267,37 @@ std::optional<BandPlace> band_place(const Scene& scene) {
   if (std::isfinite(crack.tip) && crack.tip - f.behind > f.from) place.from = std::min(crack.tip - f.behind, place.to - 4.0 * f.width);
   place.from = std::max(place.from, f.from);
   return place;
+}
+
+void BandSettling::pick(const Scene& moved) {
+  const BandFollow& f = follow_of(moved);
+  const dem::ParticleSet& p = moved.dem.particles;
+  ids_.clear();
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p.reference[i][f.along] <= f.from + f.settle_length) ids_.push_back(static_cast<std::uint32_t>(i));
+  last_kinetic_ = moved.dem.kinetic_energy(ids_);
+}
+
+void BandSettling::start(const Scene& moved) {
+  const BandFollow& f = follow_of(moved);
+  steps_left_ = static_cast<long>(std::ceil(f.settle_time / moved.dt - 1e-9));
+  steps_done_ = 0;
+  dissipated_ = 0.0;
+  pick(moved);
+}
+
+void BandSettling::carry_to(const Scene& moved) {
+  if (active()) pick(moved);
+}
+
+void BandSettling::after_step(const dem::DemModel& dem, SceneModel& model) {
+  --steps_left_;
+  ++steps_done_;
+  // Between two macro steps only, where the continuum's velocities are in step with its forces
+  // and the projection's work is the change of the kinetic energies the balance books.
+  if (!model.accepts_set_state()) return;
+  if (dem.kinetic_energy(ids_) < last_kinetic_) dissipated_ += model.arrest(ids_);
+  last_kinetic_ = dem.kinetic_energy(ids_);
 }
 
 std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace place, ZoneMove& report) {
@@ -390,6 +422,19 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
         v[3 * a + c] = dem_share * va[c] + (1.0 - dem_share) * v[3 * a + c];
       }
       ++report.nodes_from_des;
+    }
+    // A move of the start also relaxes every other node no coupled DE's field reaches (with the
+    // nodes the coupled DEs' field reaches and the driven strips held): where the DEM's weight
+    // was a fraction, the continuum's field carried only its share of the stress, and handed over
+    // as it stands it stores more than the DEM did (docs/decisions.md#d56).
+    if (start_moved) {
+      std::vector<Vec3> coupled;
+      for (std::size_t i = 0; i < pn.size(); ++i)
+        if (cn.dem_weight(pn.reference[i]) < 1.0) coupled.push_back(pn.reference[i]);
+      std::vector<char> tied(xn.size(), 0);
+      for (const auto& row : cn.shape_values(coupled))
+        for (const auto& [a, N] : row) tied[a] = 1;
+      for (std::size_t a = 0; a < xn.size(); ++a) relaxed[a] |= !tied[a];
     }
     relax_nodes(cn, relaxed, u);
     after.put("continuum/u", u);

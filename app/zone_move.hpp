@@ -33,8 +33,9 @@
 //        fitted by least squares to the 16 nearest DEs on their side of the mid-plane, at the
 //        node (displacement and velocity alike); then their displacement relaxed to the
 //        continuum's equilibrium with the other nodes held (the least strain energy: one Newton
-//        step by conjugate gradients). The coupled DEs stay where they are: the coupling keeps
-//        the displacement constraint's residual G u as it finds it
+//        step by conjugate gradients), and when `from` moves with them every node the coupled
+//        DEs' field does not reach (supports and driven strips held). The coupled DEs stay where
+//        they are: the coupling keeps the displacement constraint's residual G u as it finds it
 //        (SceneModel::displacement_residual: 0 after a move of `to` alone);
 //      * then the forces and the coupling's constraint of that state
 //        (SceneModel::resume_from_set_state). The crack sensors keep the pre-crack tip of the
@@ -45,7 +46,8 @@
 //    moved): ZoneMove::energy_jump, which the run's energy balance books as its own term. A move
 //    of `to` alone changes it by a few 1e-3 of the total or less. A move of `from` hands the
 //    DEM's wake to the continuum, the DEM's stress at the new start overlap in one step: a jump
-//    of 0.6 % (40k DCB) to 6.4 % (reduced DCB's P1 arms) of the total, and arms that ring
+//    of -0.1 % to +0.8 % (40k DCB, 2 mm arms) to 4.5 % (reduced DCB's P1 arms) of the total, and
+//    arms that ring, which the settling after it (BandSettling) does not stop
 //    (docs/decisions.md#d56).
 #pragma once
 #include <memory>
@@ -70,6 +72,30 @@ struct ZoneMove {
 };
 
 std::optional<BandPlace> band_place(const Scene& scene);
+
+// After a move of the band's start: its DEs from the new start to follow.settle_length beyond it
+// kinetically damped over the next follow.settle_time (docs/decisions.md#d56). After each macro
+// step, when their kinetic energy fell since the one before, they stop (SceneModel::arrest: their
+// kinetic energy goes to the DEM's dissipated energy, the velocities back onto the coupling's
+// constraint), as dynamic relaxation stops a structure at its kinetic energy's peaks; the rest
+// of both models steps on. A move while it lasts picks the DEs of the moved scene again: start()
+// after a move of `from`, carry_to() after another.
+class BandSettling {
+ public:
+  void start(const Scene& moved);     // the moved scene's band from `from`, for settle_time
+  void carry_to(const Scene& moved);  // the same steps left, the moved scene's DEs
+  bool active() const { return steps_left_ > 0; }
+  void after_step(const dem::DemModel& dem, SceneModel& model);  // while active()
+  double dissipated() const { return dissipated_; }  // J, since start()
+  long steps_done() const { return steps_done_; }
+  std::size_t particles() const { return ids_.size(); }
+
+ private:
+  void pick(const Scene& moved);
+  std::vector<std::uint32_t> ids_;
+  long steps_left_ = 0, steps_done_ = 0;
+  double last_kinetic_ = 0.0, dissipated_ = 0.0;
+};
 
 std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace place, ZoneMove& report);
 

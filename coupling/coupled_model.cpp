@@ -147,6 +147,19 @@ void CoupledModel::resume_from_set_state() {
   put_state_on_constraint();
 }
 
+double CoupledModel::arrest(std::span<const std::uint32_t> ids) {
+  if (!opens_macro_step()) throw std::logic_error("CoupledModel::arrest inside a macro step");
+  const double arrested = dem_.arrest(ids);
+  const auto kinetic = [this] { return dem_.kinetic_energy(ops_.particles) + continuum_kinetic_energy(); };
+  const double before = kinetic();
+  gather_dem_velocity(vd_);
+  Matrix3 dd, dc;
+  solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);  // lambda_: scratch between steps
+  scatter_dem_velocity(vd_);
+  coupling_work_ += kinetic() - before;
+  return arrested;
+}
+
 // The targets of the contract's consistent quadrature: g_a = sum_p N(p, a) h_p, h_p = sum over
 // the Laguerre faces f of DE p of alpha_d(centroid_f) A_f (the weighted bond energy's gradient
 // at p is -sigma h_p). Nodes with every dof held or fixed take reactions and get none.

@@ -196,6 +196,13 @@ class CoupledModel {
   // app/zone_move.hpp: DEs and nodes carried over from another scene, the new ones interpolated):
   // their forces again, the velocities onto the constraint and its force, as at construction.
   void resume_from_set_state();
+  // Kinetic damping between two macro steps (opens_macro_step(), where the continuum's
+  // velocities are in step with its forces): the DEs `ids` stop (DemModel::arrest, their kinetic
+  // energy booked as the DEM's dissipation), then the velocities of both models go back onto
+  // G v = 0 by the same mass-weighted projection as a step's correction. That projection is an
+  // impulse of the multipliers; the kinetic energy it changes is their work, booked in
+  // coupling_work(). Returns what the DEs lost, J.
+  double arrest(std::span<const std::uint32_t> ids);
   // Whether the next step opens a macro step of options.continuum_substeps (its continuum force
   // is then that of the present state): where a state may be set from outside.
   bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }

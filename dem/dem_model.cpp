@@ -519,6 +519,24 @@ double DemModel::kinetic_energy() const {
   return e;
 }
 
+double DemModel::kinetic_energy(std::span<const std::uint32_t> ids) const {
+  double e = 0.0;
+  for (const std::uint32_t i : ids) e += particle_kinetic_energy(i);
+  return e;
+}
+
+double DemModel::arrest(std::span<const std::uint32_t> ids) {
+  const double before = kinetic_energy(ids);
+  for (const std::uint32_t i : ids) {
+    for (int k = 0; k < 3; ++k)
+      if (!imposes(i, k)) particles.velocity[i][k] = 0.0;
+    if (!(driven_[i] & 8u)) particles.angular_velocity[i] = Vec3{};
+  }
+  const double removed = before - kinetic_energy(ids);
+  dissipated_ += removed;
+  return removed;
+}
+
 double DemModel::round_off_kinetic_energy(double time) const {
   double extent = 0.0, mass = 0.0;
   for (std::size_t i = 0; i < particles.size(); ++i) {

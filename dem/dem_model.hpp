@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -130,6 +131,11 @@ class DemModel {
   void record_energies_in_next_step() { energy_record_requested_ = true; }
   Energies energies() const;
   double kinetic_energy() const;  // Energies::kinetic alone (no bond pass), J
+  double kinetic_energy(std::span<const std::uint32_t> ids) const;  // of these DEs, J
+  // Kinetic damping (dynamic relaxation, docs/references.md#barnes1999): the DEs `ids` stop,
+  // velocity and spin zero, but for the components a kinematic condition imposes; the kinetic
+  // energy they had goes to Energies::dissipated. Between two steps. Returns that energy, J.
+  double arrest(std::span<const std::uint32_t> ids);
   double external_work() const { return external_work_; }  // J, cheap (no energy sums)
   // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
   Vec3 reaction_on(int group) const { return reaction_[group]; }
