@@ -662,7 +662,6 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
   // After a move of the start, the settling of the DEs around it; its row in zone_moves.
   BandSettling settling;
   std::size_t settling_row = 0;
-  double settling_dissipated = 0.0;  // J, by the settlings before the present one
   const auto record_settling = [&] {
     if (settling.steps_done() == 0) return;
     Json& row = zone_moves[settling_row];
@@ -708,9 +707,8 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     row["energy_before"] = move.energy_before;
     row["seconds"] = move.setup_seconds;
     zone_moves.push_back(row);
-    if (start_moves && scene->continuum->band_follow()->settle_time > 0.0) {
+    if (start_moves) {  // a settle_time of 0 starts none
       record_settling();
-      settling_dissipated += settling.dissipated();
       settling.start(*scene);
       settling_row = zone_moves.size() - 1;
     } else {
@@ -828,7 +826,9 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     summary["zone_moves"] = zone_moves;
     summary["zone_energy_jumps"] = zone_energy_jumps;
     record_settling();
-    summary["zone_settling_dissipated"] = settling_dissipated + settling.dissipated();
+    double settled = 0.0;
+    for (const Json& row : zone_moves) settled += row.value("settling_dissipated", 0.0);
+    summary["zone_settling_dissipated"] = settled;
   }
   if (!model->bond_sets().empty()) {
     Json& bonds = counts["bonds"];

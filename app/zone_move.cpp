@@ -296,8 +296,13 @@ void BandSettling::after_step(const dem::DemModel& dem, SceneModel& model) {
   // Between two macro steps only, where the continuum's velocities are in step with its forces
   // and the projection's work is the change of the kinetic energies the balance books.
   if (!model.accepts_set_state()) return;
-  if (dem.kinetic_energy(ids_) < last_kinetic_) dissipated_ += model.arrest(ids_);
-  last_kinetic_ = dem.kinetic_energy(ids_);
+  const double kinetic = dem.kinetic_energy(ids_);
+  if (kinetic < last_kinetic_) {
+    dissipated_ += model.arrest(ids_);
+    last_kinetic_ = dem.kinetic_energy(ids_);  // what imposed motion leaves
+  } else {
+    last_kinetic_ = kinetic;
+  }
 }
 
 std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace place, ZoneMove& report) {

@@ -127,10 +127,7 @@ CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& conti
 // the unconstrained accelerations (what the first half kick of the next step applies).
 void CoupledModel::put_state_on_constraint() {
   const int np = ops_.num_particles(), nn = continuum_.num_nodes();
-  gather_dem_velocity(vd_);
-  Matrix3 dd, dc;
-  solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);
-  scatter_dem_velocity(vd_);
+  project_velocities();
   Matrix3 ad(np, 3);
   for (int p = 0; p < np; ++p) {
     const Vec3& f = dem_.particles.force[ops_.particles[p]];
@@ -139,6 +136,13 @@ void CoupledModel::put_state_on_constraint() {
   Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
       Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
   solver_->project(ad, ac, acc_d_, acc_c_, mu_);
+}
+
+void CoupledModel::project_velocities() {
+  gather_dem_velocity(vd_);
+  Matrix3 dd, dc;
+  solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);
+  scatter_dem_velocity(vd_);
 }
 
 void CoupledModel::resume_from_set_state() {
@@ -152,10 +156,7 @@ double CoupledModel::arrest(std::span<const std::uint32_t> ids) {
   const double arrested = dem_.arrest(ids);
   const auto kinetic = [this] { return dem_.kinetic_energy(ops_.particles) + continuum_kinetic_energy(); };
   const double before = kinetic();
-  gather_dem_velocity(vd_);
-  Matrix3 dd, dc;
-  solver_->project(vd_, continuum_velocity(), dd, dc, lambda_);  // lambda_: scratch between steps
-  scatter_dem_velocity(vd_);
+  project_velocities();  // lambda_ is scratch between steps
   coupling_work_ += kinetic() - before;
   return arrested;
 }

@@ -221,6 +221,8 @@ class CoupledModel {
   // The constructor's and resume_from_set_state's last part: the velocities onto G v = 0, the
   // constraint force of the present forces.
   void put_state_on_constraint();
+  // Both models' velocities onto G v = 0 (the mass-weighted projection); lambda_ as scratch.
+  void project_velocities();
   // The phases of step(), in order (see the contract above).
   void constraint_half_kick(double dt);
   void advance_models(double dt);
