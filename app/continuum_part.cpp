@@ -125,8 +125,9 @@ constexpr KeyDoc follow_keys[] = {
     {"ahead", KeyType::number, "m", Range::positive(), "", "its new to: this beyond the damage front (at most until; more than margin)"},
     {"behind", KeyType::number, "m", Range::positive(), "(from stays)", "its new from: this behind the crack tip (never back; moving it disturbs the run, docs/decisions.md#d56)"},
     {"until", KeyType::number, "m", Range::any(), "", "the furthest to: the band's to with the whole interface in it"},
-    {"settle_time", KeyType::number, "s", Range::non_negative(), "4e-05", "after a move of from: how long the DEs around the new start are kinetically damped (0: not)"},
+    {"settle_time", KeyType::number, "s", Range::non_negative(), "0", "after a move of from: how long the DEs around the new start are kinetically damped (0: not; measured worse than relax_steps alone)"},
     {"settle_length", KeyType::number, "m", Range::positive(), "0.006", "after a move of from: the damped DEs reach this beyond the new from"},
+    {"relax_steps", KeyType::integer, "", Range::between(0, 1000000), "2000", "after a move of from: pseudo-time steps of the coupled state's dynamic relaxation toward the accelerations before the move (0: none)"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -332,8 +333,9 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
       CaseNode f = band.child("follow");
       follow = BandFollow{f.number("margin", Range::positive(), "m"), f.number("ahead", Range::positive(), "m"),
                           f.number_or("behind", INFINITY, Range::positive(), "m"), f.number("until", Range::any(), "m"), axis, along, center, from, to,
-                          width, f.number_or("settle_time", 4.0e-5, Range::non_negative(), "s"),
-                          f.number_or("settle_length", 6.0e-3, Range::positive(), "m"), f.where()};
+                          width, f.number_or("settle_time", 0.0, Range::non_negative(), "s"),
+                          f.number_or("settle_length", 6.0e-3, Range::positive(), "m"),
+                          static_cast<int>(f.integer_or("relax_steps", 2000, Range::between(0, 1000000))), f.where()};
       if (follow->ahead <= follow->margin)
         f.fail("ahead", "expected more than margin (" + std::to_string(follow->margin) + " m): the band would move again at once");
       if (follow->until < to) f.fail("until", "expected the band's furthest end, at or beyond its to (" + std::to_string(to) + " m)");
@@ -423,6 +425,11 @@ class Coupled final : public SceneModel {
   void resume_from_set_state() override { model_->resume_from_set_state(); }
   double displacement_residual() const override { return model_->displacement_residual(); }
   double arrest(std::span<const std::uint32_t> ids) override { return model_->arrest(ids); }
+  void save_accelerations(StateArchive& archive) const override { model_->save_accelerations(archive); }
+  RelaxationReport relax(double dt, int steps, const StateArchive& target) override {
+    const auto r = model_->relax(dt, steps, target);
+    return {r.steps, r.imbalance_before, r.imbalance_after, r.free_rigid_motions, r.fracture};
+  }
   std::optional<OverlapDamageReport> damage_in_overlap() override {
     const auto damage = model_->damage_in_overlap();
     if (!damage) return std::nullopt;

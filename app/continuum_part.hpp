@@ -52,9 +52,12 @@ struct BandFollow {
   int axis = 2, along = 0;                                 // the band's (0, 1, 2)
   double center = 0.0, from = 0.0, to = 0.0, width = 0.0;  // m, the band as read
   // After a move of `from`, the DEs from it to settle_length beyond it are kinetically damped
-  // over settle_time (app/zone_move.hpp: BandSettling).
+  // over settle_time (app/zone_move.hpp: BandSettling; 0 by default).
   double settle_time = 0.0;    // s
   double settle_length = 0.0;  // m
+  // After a move of `from`, this many pseudo-time steps of dynamic relaxation toward the
+  // accelerations before it (SceneModel::relax).
+  int relax_steps = 0;
   std::string where;                         // file:line of the follow section
 };
 

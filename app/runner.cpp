@@ -706,6 +706,13 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
     row["energy_jump"] = move.energy_jump();
     row["energy_before"] = move.energy_before;
     row["seconds"] = move.setup_seconds;
+    if (move.relaxation.steps > 0) {
+      row["relaxation_steps"] = move.relaxation.steps;
+      row["relaxation_imbalance_before"] = move.relaxation.imbalance_before;
+      row["relaxation_imbalance_after"] = move.relaxation.imbalance_after;
+      row["relaxation_free_rigid_motions"] = move.relaxation.free_rigid_motions;
+      row["relaxation_fracture"] = move.relaxation.fracture;
+    }
     zone_moves.push_back(row);
     if (start_moves) {  // a settle_time of 0 starts none
       record_settling();
@@ -719,6 +726,9 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
                  "added, energy %+.3g J of %.3g J, %.2f s\n",
                  steps_done, current_time(), place.from, place.to, move.des, move.des_added, move.des_dropped, move.nodes_added, move.energy_jump(),
                  move.energy_before, move.setup_seconds);
+    if (move.relaxation.steps > 0)
+      std::fprintf(stderr, "  relaxed in %d pseudo-time steps: imbalance sum m|a - a_before|^2 %.3g -> %.3g J/s^2 (%d free rigid motions)\n",
+                   move.relaxation.steps, move.relaxation.imbalance_before, move.relaxation.imbalance_after, move.relaxation.free_rigid_motions);
   };
 
   const auto t_start = Clock::now();

@@ -47,6 +47,14 @@ struct OverlapDamageReport {
   bool held = false;        // the bonds were held intact, not broken
 };
 
+// What SceneModel::relax did: its steps and sum m |P (a - a_target)|^2 before and after, J/s^2.
+struct RelaxationReport {
+  int steps = 0;
+  double imbalance_before = 0.0, imbalance_after = 0.0;
+  int free_rigid_motions = 0;  // rigid motions no held dof stops, their share of the target left out
+  double fracture = 0.0;  // J: dissipated by the links' damage as it relaxed (in E_fracture)
+};
+
 class SceneModel {
  public:
   virtual ~SceneModel() = default;
@@ -76,6 +84,11 @@ class SceneModel {
   // takes out is booked (coupling/coupled_model.hpp: CoupledModel::arrest). Returns the DEs' part
   // of it, J.
   virtual double arrest(std::span<const std::uint32_t> ids) { throw std::logic_error("only a coupled scene's zone settles"); }
+  // Dynamic relaxation of a state set from outside toward the constrained accelerations of
+  // `target` (save_accelerations' entries, rows as this model's; coupling/coupled_model.hpp:
+  // CoupledModel::relax): the displacements move, the motion stays.
+  virtual void save_accelerations(StateArchive& archive) const { throw std::logic_error("only a coupled scene relaxes"); }
+  virtual RelaxationReport relax(double dt, int steps, const StateArchive& target) { throw std::logic_error("only a coupled scene relaxes"); }
   virtual std::string summary() const { return ""; }  // lines printed at start (the coupling's)
   virtual void describe(Json& counts) const {}       // summary.json counts of its own
 };

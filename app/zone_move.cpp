@@ -87,6 +87,15 @@ void carry_rows(const StateArchive& from, StateArchive& to, const std::string& n
 
 void carry_entry(const StateArchive& from, StateArchive& to, const std::string& name) { to.put_entry(name, from.entries().at(name)); }
 
+// Row r of `archive`'s entry `name` to zero where map[r] == -2.
+void zero_rows(StateArchive& archive, const std::string& name, const std::vector<long>& map) {
+  StateArchive::Entry entry = archive.entries().at(name);
+  const std::size_t row = entry.width * element_size(entry.kind);
+  for (std::size_t r = 0; r < map.size(); ++r)
+    if (map[r] == -2) std::memset(entry.bytes.data() + r * row, 0, row);
+  archive.put_entry(name, std::move(entry));
+}
+
 // The break records under `prefix` of the bonds both scenes have, renumbered; their count.
 std::size_t carry_events(const StateArchive& from, StateArchive& to, const std::string& prefix,
                          const std::vector<std::vector<long>>& new_bond_of_old) {
@@ -405,6 +414,7 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
                            "continuum/dissipated", "coupling/work", "coupling/time", "coupling/steps"})
     carry_entry(before, after, name);
   for (const char* name : {"continuum/u", "continuum/v"}) carry_rows(before, after, name, old_dof_of_new);
+  const bool start_moved = place.from > follow_of(current).from;
   {
     // Where the DEM's weight falls (the zone left it) and where the continuum is new: the DEs'
     // motion for the share the DEM carried, then the displacement relaxed to the continuum's
@@ -412,7 +422,6 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
     // overlap reaches that lay in the DEM-only zone: the continuum weighed them as nothing, so
     // their field is no continuum's own, and the overlap now weighs it.
     auto u = after.get<double>("continuum/u"), v = after.get<double>("continuum/v");
-    const bool start_moved = place.from > follow_of(current).from;
     const double start_reach = cn.vertex_plane_from(f0.along, place.from + f0.width);
     std::vector<char> relaxed(xn.size(), 0);
     for (std::size_t a = 0; a < xn.size(); ++a) {
@@ -454,6 +463,30 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
   next->model->load_state(after);
   take_motion_from_continuum(co, before.get<double>("continuum/u"), before.get<double>("continuum/v"), next->dem.particles, old_of_new);
   next->model->resume_from_set_state();
+  // A move of the start hands the wake's stress to the continuum in one step: the state is
+  // relaxed toward the accelerations each DE and node had before (those new to the zone: their
+  // own now), so that the move leaves no force it did not find; but toward rest where the weight
+  // of a DE or node rose: what it had was the coupling's, the other model's motion followed with
+  // a mass too small to carry it, which its new mass would turn into a force the state never
+  // had (docs/decisions.md#d56).
+  if (const int steps = follow_of(*next).relax_steps; start_moved && steps > 0) {
+    StateArchive was, target;
+    current.model->save_accelerations(was);
+    next->model->save_accelerations(target);
+    std::vector<long> de_rows = old_of_new, dof_rows = old_dof_of_new;
+    for (std::size_t i = 0; i < pn.size(); ++i)
+      if (de_rows[i] >= 0 && pn.mass(i) > po.mass(static_cast<std::size_t>(de_rows[i]))) de_rows[i] = -2;
+    const auto mass_before = before.get<double>("continuum/lumped_mass"), mass_after = after.get<double>("continuum/lumped_mass");
+    for (std::size_t d = 0; d < dof_rows.size(); ++d)
+      if (dof_rows[d] >= 0 && mass_after[d] > mass_before[static_cast<std::size_t>(dof_rows[d])]) dof_rows[d] = -2;
+    carry_rows(was, target, "accelerations/dem/translation", de_rows);
+    carry_rows(was, target, "accelerations/dem/rotation", de_rows);
+    carry_rows(was, target, "accelerations/continuum", dof_rows);
+    zero_rows(target, "accelerations/dem/translation", de_rows);
+    zero_rows(target, "accelerations/dem/rotation", de_rows);
+    zero_rows(target, "accelerations/continuum", dof_rows);
+    report.relaxation = next->model->relax(current.dt, steps, target);
+  }
 
   // The crack sensors go on from the run's pre-crack tip, and count what the links left behind
   // dissipated.

@@ -39,15 +39,19 @@
 //        (SceneModel::displacement_residual: 0 after a move of `to` alone);
 //      * then the forces and the coupling's constraint of that state
 //        (SceneModel::resume_from_set_state). The crack sensors keep the pre-crack tip of the
-//        scene as first built, and the energy dissipated by links left behind.
+//        scene as first built, and the energy dissipated by links left behind;
+//      * after a move of `from`, follow.relax_steps of the coupled state's dynamic relaxation
+//        (SceneModel::relax) toward the constrained accelerations each DE and continuum dof had
+//        before (those new to the zone: their own; those whose mass rose with their weight: rest),
+//        so that the move leaves no force it did not find (ZoneMove::relaxation).
 //    Only between two steps where current.model->accepts_set_state(). InputError (naming the
 //    follow section) where the case cannot move: no interface, a join that is not a box.
 //  - The move changes the total energy (DEs and links dropped behind and added ahead, weights
-//    moved): ZoneMove::energy_jump, which the run's energy balance books as its own term. A move
-//    of `to` alone changes it by a few 1e-3 of the total or less. A move of `from` hands the
-//    DEM's wake to the continuum, the DEM's stress at the new start overlap in one step: a jump
-//    of -0.1 % to +0.8 % (40k DCB, 2 mm arms) to 4.5 % (reduced DCB's P1 arms) of the total, and
-//    arms that ring, which the settling after it (BandSettling) does not stop
+//    moved, the relaxation): ZoneMove::energy_jump, which the run's energy balance books as its
+//    own term, less what the relaxation's damage dissipated (booked as fracture). A move of `to`
+//    alone changes it by a few 1e-3 of the total or less. A move of `from` hands the DEM's wake to
+//    the continuum, the DEM's stress at the new start overlap in one step; without the relaxation
+//    the arms then ring, which the settling after it (BandSettling) does not stop
 //    (docs/decisions.md#d56).
 #pragma once
 #include <memory>
@@ -67,8 +71,11 @@ struct ZoneMove {
   std::size_t nodes_from_des = 0;         // nodes whose motion the DEs gave (those added among them)
   std::size_t links_dropped_broken = 0;  // bonds left behind broken (with their break records)
   double energy_before = 0.0, energy_after = 0.0;  // J, the scene's total energy
-  double energy_jump() const { return energy_after - energy_before; }
+  // The change of the total energy the balance books as the move's: all of it but what the
+  // relaxation's damage dissipated, which E_fracture books.
+  double energy_jump() const { return energy_after - energy_before + relaxation.fracture; }
   double setup_seconds = 0.0;  // building the new scene and carrying the state
+  RelaxationReport relaxation;  // after a move of from (follow.relax_steps; steps 0: none)
 };
 
 std::optional<BandPlace> band_place(const Scene& scene);

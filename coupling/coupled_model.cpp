@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+
 #include "common/error.hpp"
 #include "common/parallel.hpp"
 #include "dem/laguerre_cells.hpp"
@@ -159,6 +161,217 @@ double CoupledModel::arrest(std::span<const std::uint32_t> ids) {
   project_velocities();  // lambda_ is scratch between steps
   coupling_work_ += kinetic() - before;
   return arrested;
+}
+
+void CoupledModel::save_accelerations(StateArchive& archive) const {
+  const auto& P = dem_.particles;
+  std::vector<Vec3> translation(P.size()), rotation(P.size());
+  for (std::size_t i = 0; i < P.size(); ++i)
+    translation[i] = P.force[i] * P.inv_mass[i], rotation[i] = P.torque[i] * P.inv_inertia(i);
+  for (int p = 0; p < ops_.num_particles(); ++p) translation[ops_.particles[p]] -= Vec3{acc_d_(p, 0), acc_d_(p, 1), acc_d_(p, 2)};
+  const auto& f = continuum_.force();
+  std::vector<double> nodes(f.size(), 0.0);
+  for (std::size_t d = 0; d < f.size(); ++d)
+    if (inv_mass_c_[d] != 0.0 && !continuum_.is_fixed(static_cast<int>(d)))
+      nodes[d] = f[d] * inv_mass_c_[d] - acc_c_(static_cast<Eigen::Index>(d / 3), static_cast<Eigen::Index>(d % 3));
+  archive.put("accelerations/dem/translation", translation);
+  archive.put("accelerations/dem/rotation", rotation);
+  archive.put("accelerations/continuum", nodes);
+}
+
+CoupledModel::Relaxation CoupledModel::relax(double dt, int steps, const StateArchive& target) {
+  if (!opens_macro_step()) throw std::logic_error("CoupledModel::relax inside a macro step");
+  auto& P = dem_.particles;
+  const std::size_t n = P.size();
+  // What each DE and dof is to keep unbalanced: M a_target.
+  std::vector<Vec3> force_offset = target.get<Vec3>("accelerations/dem/translation"),
+                    torque_offset = target.get<Vec3>("accelerations/dem/rotation");
+  const std::vector<double> continuum_target = target.get<double>("accelerations/continuum");
+  if (force_offset.size() != n || torque_offset.size() != n || continuum_target.size() != inv_mass_c_.size())
+    throw std::logic_error("CoupledModel::relax: the target's accelerations are not this model's");
+  for (std::size_t i = 0; i < n; ++i) force_offset[i] *= P.mass(i), torque_offset[i] *= P.inertia(i);
+  std::vector<double> continuum_offset = continuum_target;
+  Relaxation out;
+  out.free_rigid_motions = remove_free_rigid_share(force_offset, torque_offset, continuum_offset);
+  std::vector<char> moves(inv_mass_c_.size());
+  for (std::size_t d = 0; d < moves.size(); ++d) moves[d] = inv_mass_c_[d] != 0.0 && !continuum_.is_fixed(static_cast<int>(d));
+
+  StateArchive start;
+  save_state(start);
+  const double fracture_before = dem_.energies().fracture;
+  auto& uc = continuum_.displacement();
+  auto& vc = continuum_.velocity();
+  const auto stop = [&] {
+    dem_.stop_motion();
+    std::fill(vc.begin(), vc.end(), 0.0);
+  };
+  const auto kick = [&](double h) {
+    dem_.relaxation_kick(h, force_offset, torque_offset);
+    const auto& f = continuum_.force();
+    for (std::size_t d = 0; d < vc.size(); ++d)
+      if (moves[d]) vc[d] += h * (f[d] * inv_mass_c_[d] - continuum_offset[d]);
+    project_velocities();
+  };
+  const auto kinetic = [&] { return dem_.kinetic_energy() + continuum_.kinetic_energy(); };
+  // sum m |P (a - a_target)|^2 = 2 T / h^2 for the velocities a kick by h from rest gives.
+  const auto imbalance = [&] {
+    constexpr double h = 1.0;  // the velocities are scratch: any h measures it
+    stop();
+    kick(h);
+    const double value = 2.0 * kinetic() / (h * h);
+    stop();
+    return value;
+  };
+  out.steps = steps;
+  out.imbalance_before = imbalance();
+  double last = 0.0;
+  for (int k = 0; k < steps; ++k) {
+    kick(0.5 * dt);
+    dem_.relaxation_drift(dt);
+    for (std::size_t d = 0; d < uc.size(); ++d)
+      if (moves[d]) uc[d] += dt * vc[d];
+    continuum_.compute_forces();
+    kick(0.5 * dt);
+    const double now = kinetic();
+    if (now < last) stop(), last = 0.0;
+    else last = now;
+  }
+  out.imbalance_after = imbalance();
+
+  // The relaxed displacements, and the damage of the cohesive links with what its growth
+  // dissipated: their forces follow the path the relaxation took, and a link put at its relaxed
+  // opening with the damage it had before would dissipate in one step more than the energy it
+  // gives up (the law's dissipation assumes small steps along its envelope).
+  StateArchive relaxed;
+  save_state(relaxed);
+  const auto ends_with = [](const std::string& name, const std::string& tail) {
+    return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  for (const auto& [name, entry] : relaxed.entries())
+    if (name == "dem/particles/position" || name == "dem/particles/orientation" || name == "continuum/u" ||
+        (name.rfind("dem/bonds/", 0) == 0 && (ends_with(name, "/damage") || ends_with(name, "/dissipated"))))
+      start.put_entry(name, entry);
+  load_state(start);
+  resume_from_set_state();
+  out.fracture = dem_.energies().fracture - fracture_before;
+  return out;
+}
+
+// Rigid motions of both models: translations along x, y, z (modes 0-2) and turns about the
+// axes through the centre of mass c (3-5; the turn scaled by the models' radius of gyration, so
+// that all six have velocities of one scale). A DE or node at x moves at velocity(j, x) per unit
+// of mode j, and a DE turns at spin(j).
+namespace {
+struct RigidModes {
+  Vec3 centre{};
+  double radius = 1.0;  // m
+  Vec3 velocity(int j, const Vec3& x) const {
+    Vec3 e{};
+    e[j % 3] = 1.0;
+    return j < 3 ? e : cross(e, x - centre) * (1.0 / radius);
+  }
+  Vec3 spin(int j) const {
+    Vec3 e{};
+    if (j >= 3) e[j - 3] = 1.0 / radius;
+    return e;
+  }
+};
+}  // namespace
+
+int CoupledModel::remove_free_rigid_share(std::vector<Vec3>& force_offset, std::vector<Vec3>& torque_offset,
+                                          std::vector<double>& continuum_target) const {
+  using Matrix6 = Eigen::Matrix<double, 6, 6>;
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
+  const auto& P = dem_.particles;
+  const std::size_t n = P.size(), nn = static_cast<std::size_t>(continuum_.num_nodes());
+  const auto& mass_c = continuum_.dof_mass();
+  const auto node_position = [&](std::size_t a) {
+    return continuum_.nodes()[a] + Vec3{continuum_.displacement()[3 * a], continuum_.displacement()[3 * a + 1], continuum_.displacement()[3 * a + 2]};
+  };
+  const auto held_c = [&](std::size_t d) { return inv_mass_c_[d] == 0.0 || continuum_.is_fixed(static_cast<int>(d)); };
+  RigidModes modes;
+  double mass = 0.0, second = 0.0;
+  for (std::size_t i = 0; i < n; ++i) modes.centre += P.position[i] * P.mass(i), mass += P.mass(i);
+  for (std::size_t a = 0; a < nn; ++a) modes.centre += node_position(a) * mass_c[3 * a], mass += mass_c[3 * a];
+  if (!(mass > 0.0)) return 0;
+  modes.centre = modes.centre * (1.0 / mass);
+  for (std::size_t i = 0; i < n; ++i) second += P.mass(i) * norm2(P.position[i] - modes.centre);
+  for (std::size_t a = 0; a < nn; ++a) second += mass_c[3 * a] * norm2(node_position(a) - modes.centre);
+  modes.radius = std::max(std::sqrt(second / mass), 1e-300);
+
+  // Which combinations of the six every held dof stops: the null space of sum over held dofs of
+  // m m^T, m the six modes' values there.
+  Matrix6 held = Matrix6::Zero();
+  Vector6 value;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t imposed = dem_.imposed_motion(i);
+    if (imposed == 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      if (imposed >> k & 1) {
+        for (int j = 0; j < 6; ++j) value[j] = modes.velocity(j, P.position[i])[k];
+        held += value * value.transpose();
+      }
+      if (imposed & 8u) {
+        for (int j = 0; j < 6; ++j) value[j] = modes.spin(j)[k];
+        held += value * value.transpose();
+      }
+    }
+  }
+  for (std::size_t d = 0; d < 3 * nn; ++d) {
+    if (!held_c(d)) continue;
+    for (int j = 0; j < 6; ++j) value[j] = modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)];
+    held += value * value.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(held);
+  const double scale = std::max(eigen.eigenvalues().maxCoeff(), 1.0);
+  int free = 0;
+  Matrix6 basis = Matrix6::Zero();  // the free combinations, as columns
+  for (int j = 0; j < 6; ++j)
+    if (eigen.eigenvalues()[j] <= 1e-12 * scale) basis.col(free++) = eigen.eigenvectors().col(j);
+  if (free == 0) return 0;
+
+  // Their mass matrix and the target's net force on them: sum over the free dofs of
+  // phi . M phi and phi . (f - M a_target).
+  Matrix6 mode_mass = Matrix6::Zero();
+  Vector6 force = Vector6::Zero();
+  Eigen::Matrix<double, 3, 6> v, w;
+  for (int j = 0; j < 6; ++j)
+    for (int k = 0; k < 3; ++k) w(k, j) = modes.spin(j)[k];
+  const Eigen::Matrix<double, 3, 6> w_free = w * basis;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 3; ++k) v(k, j) = modes.velocity(j, P.position[i])[k];
+    const Eigen::Matrix<double, 3, 6> v_free = v * basis;
+    const Vec3 df = P.force[i] - force_offset[i], dt = P.torque[i] - torque_offset[i];
+    mode_mass += P.mass(i) * v_free.transpose() * v_free + P.inertia(i) * w_free.transpose() * w_free;
+    force += v_free.transpose() * Eigen::Vector3d(df.x, df.y, df.z) + w_free.transpose() * Eigen::Vector3d(dt.x, dt.y, dt.z);
+  }
+  const auto& f = continuum_.force();
+  for (std::size_t d = 0; d < 3 * nn; ++d) {
+    if (held_c(d)) continue;
+    Vector6 phi;
+    for (int j = 0; j < 6; ++j) phi[j] = modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)];
+    const Vector6 phi_free = basis.transpose() * phi;
+    mode_mass += mass_c[d] * phi_free * phi_free.transpose();
+    force += phi_free * (f[d] - mass_c[d] * continuum_target[d]);
+  }
+  // The rigid acceleration that force gives, added to every target (the unused columns of the
+  // basis are zero: a unit diagonal there keeps the 6 x 6 solve regular and leaves them zero).
+  for (int j = free; j < 6; ++j) mode_mass(j, j) = 1.0;
+  const Vector6 c6 = basis * mode_mass.ldlt().solve(force);
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 a{}, alpha{};
+    for (int j = 0; j < 6; ++j) a += modes.velocity(j, P.position[i]) * c6[j], alpha += modes.spin(j) * c6[j];
+    force_offset[i] += a * P.mass(i);
+    torque_offset[i] += alpha * P.inertia(i);
+  }
+  for (std::size_t d = 0; d < 3 * nn; ++d) {
+    if (held_c(d)) continue;
+    double a = 0.0;
+    for (int j = 0; j < 6; ++j) a += modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)] * c6[j];
+    continuum_target[d] += a;
+  }
+  return free;
 }
 
 // The targets of the contract's consistent quadrature: g_a = sum_p N(p, a) h_p, h_p = sum over

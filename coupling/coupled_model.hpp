@@ -203,6 +203,37 @@ class CoupledModel {
   // impulse of the multipliers; the kinetic energy it changes is their work, booked in
   // coupling_work(). Returns what the DEs lost, J.
   double arrest(std::span<const std::uint32_t> ids);
+  // Dynamic relaxation of a state set from outside (after resume_from_set_state, where
+  // opens_macro_step()): it moves the displacements, not the motion, toward the state whose
+  // constrained accelerations are `target`'s (save_accelerations' entries, e.g. those each DE
+  // and node had before a zone moved, so that the move leaves no force it did not find).
+  // `steps` pseudo-time steps of dt with the time standing still (DemModel::relaxation_kick:
+  // imposed components and held dofs still, no failure): both models kicked by
+  // M^-1 (f - M a_target), their velocities onto G v = 0 after each kick, and all velocities
+  // zeroed where the kinetic energy fell (kinetic damping at its peaks,
+  // docs/references.md#barnes1999). Then the state it started from takes the relaxed DE
+  // positions, orientations and continuum displacements, and the cohesive links' damage and
+  // dissipation, which grow along the relaxation's path as along a step's (velocities, time
+  // and the other running sums as they were), and resumes (resume_from_set_state); G u keeps
+  // what it found.
+  // A net force on a rigid motion that no held dof stops (for the DCB held at its load lines
+  // along z only: along x and y, and turns about z and about the load line) has no static state:
+  // pseudo-time would carry the whole away at constant acceleration, the kinetic energy would
+  // never fall and nothing would be damped. The target's share on those motions, what the state
+  // set changed of the total momentum, is left to the run: the targets are shifted by the rigid
+  // acceleration that cancels it (M-weighted, rotations about the centre of mass).
+  // The relaxation changes the total energy, which the caller books as the move's. Returned:
+  // sum m |P (a - a_target)|^2 over both models, P the projection onto G a = 0, before and after.
+  struct Relaxation {
+    int steps = 0;
+    double imbalance_before = 0.0, imbalance_after = 0.0;  // W/s = J/s^2
+    int free_rigid_motions = 0;  // whose share of the target was taken out
+    double fracture = 0.0;  // J: what the growth of the links' damage dissipated (kept, in E_fracture)
+  };
+  // The constrained accelerations of the present state under "accelerations/": per DE
+  // (translation m/s^2, rotation rad/s^2) and per continuum dof (0 on held ones).
+  void save_accelerations(StateArchive& archive) const;
+  Relaxation relax(double dt, int steps, const StateArchive& target);
   // Whether the next step opens a macro step of options.continuum_substeps (its continuum force
   // is then that of the present state): where a state may be set from outside.
   bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }
@@ -223,6 +254,11 @@ class CoupledModel {
   void put_state_on_constraint();
   // Both models' velocities onto G v = 0 (the mass-weighted projection); lambda_ as scratch.
   void project_velocities();
+  // relax's targets (M a_target, per DE force and torque; per continuum dof the acceleration)
+  // less their share on the rigid motions that no held dof stops (see relax).
+  // Returns how many independent rigid motions were free.
+  int remove_free_rigid_share(std::vector<Vec3>& force_offset, std::vector<Vec3>& torque_offset,
+                              std::vector<double>& continuum_target) const;
   // The phases of step(), in order (see the contract above).
   void constraint_half_kick(double dt);
   void advance_models(double dt);

@@ -153,6 +153,7 @@ void DemModel::finalize() {
 }
 
 void DemModel::restart_forces() {
+  energy_record_step_ = -1;  // bond energies recorded before are another state's
   compute_forces();
   record_reactions();
   apply_loads_and_damping();
@@ -535,6 +536,30 @@ double DemModel::arrest(std::span<const std::uint32_t> ids) {
   const double removed = before - kinetic_energy(ids);
   dissipated_ += removed;
   return removed;
+}
+
+void DemModel::relaxation_kick(double h, std::span<const Vec3> force_offset, std::span<const Vec3> torque_offset) {
+  ParticleSet& p = particles;
+  const long n = static_cast<long>(p.size());
+  for_each_index(n, n > parallel_threshold, [&](long i) {
+    p.velocity[i] += (p.force[i] - force_offset[i]) * (h * p.inv_mass[i]);
+    p.angular_velocity[i] += (p.torque[i] - torque_offset[i]) * (h * p.inv_inertia(i));
+    for (int k = 0; k < 3; ++k)
+      if (imposes(i, k)) p.velocity[i][k] = 0.0;
+    if (driven_[i] & 8u) p.angular_velocity[i] = Vec3{};
+  });
+}
+
+void DemModel::relaxation_drift(double dt) {
+  drift(dt);
+  update_neighbours();
+  compute_forces({}, true);
+  apply_loads_and_damping();
+}
+
+void DemModel::stop_motion() {
+  std::fill(particles.velocity.begin(), particles.velocity.end(), Vec3{});
+  std::fill(particles.angular_velocity.begin(), particles.angular_velocity.end(), Vec3{});
 }
 
 double DemModel::round_off_kinetic_energy(double time) const {

@@ -64,6 +64,9 @@ class DemModel {
   void add_boundary(const BoundaryCondition& bc);
   // DEs whose motion a kinematic condition imposes (valid before finalize()).
   std::vector<std::uint32_t> driven_particles() const;
+  // What kinematic conditions impose on DE i (after finalize()): bits 0-2 its x, y, z velocity,
+  // bit 3 its rotation (locked).
+  std::uint8_t imposed_motion(std::size_t i) const { return driven_[i]; }
   // Viscous damping, force -c m v and torque -c I omega, c in 1/s (quasi-static runs).
   void set_damping(double coefficient) { damping_ = coefficient; }
   // A uniform body force m g on every DE (m/s^2), on the components no kinematic condition
@@ -136,6 +139,16 @@ class DemModel {
   // velocity and spin zero, but for the components a kinematic condition imposes; the kinetic
   // energy they had goes to Energies::dissipated. Between two steps. Returns that energy, J.
   double arrest(std::span<const std::uint32_t> ids);
+  // Pseudo-time steps of dynamic relaxation (CoupledModel::relax), which seeks a state's
+  // equilibrium, not its motion: the time stands still, so imposed components do not move
+  // (their velocity is held at 0), no bond fails, and the forces are those of the bonds,
+  // contacts, loads and damping less `offset` (force and torque per DE: what each DE is to keep
+  // unbalanced). relaxation_kick: v += h M^-1 (f - offset), w likewise; relaxation_drift: the
+  // drift by dt and those forces. Running sums (work, dissipation) may change: the caller keeps
+  // the state it started from (save_state) and takes only the positions from the relaxation.
+  void relaxation_kick(double h, std::span<const Vec3> force_offset, std::span<const Vec3> torque_offset);
+  void relaxation_drift(double dt);
+  void stop_motion();  // every velocity and spin to 0 (kinetic damping at a peak)
   double external_work() const { return external_work_; }  // J, cheap (no energy sums)
   // Force that boundary and loads apply to the group, -(bond + contact forces on it), N.
   Vec3 reaction_on(int group) const { return reaction_[group]; }

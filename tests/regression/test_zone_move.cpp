@@ -165,10 +165,11 @@ TEST(ZoneMove, AGrowingBandFollowsTheWholeBandsDcb) {
 
 // A move of the band's start (follow with `behind`) on the reduced DCB: the DEM's wake behind the
 // tip goes to the continuum. The coupled DEs stay where they were, so the displacement
-// constraint keeps the DEs' offset from the continuum's field (its residual is the same after the
-// moves that follow), and the energy jumps by less than when they were put onto that field.
-// Then the DEs around the new start settle (kinetic damping over settle_time, 40 us): what that
-// takes out is booked, and the balance closes.
+// constraint keeps the DEs' offset from the continuum's field (its residual stays as the next
+// moves find it). Each move of the start relaxes the coupled state toward the forces before it
+// (follow.relax_steps, 2000 by default), which the DEs' damage follows; the DEs around the new
+// start then settle (kinetic damping, here over 20 us to cover it: off by default). What both
+// change or take out is booked, and the balance closes.
 TEST(ZoneMove, MovingTheStartLeavesTheCoupledDesWhereTheyAre) {
   const auto out = test::scratch_dir("zone_move_start");
   const auto r = test::run_arlequin(
@@ -179,44 +180,50 @@ TEST(ZoneMove, MovingTheStartLeavesTheCoupledDesWhereTheyAre) {
       " --set checks=[] --set 'output={every: 2.0e-5, fields: []}' --set time.end=8.0e-4"
       " --set coupling.overlap.band.to=0.022 --set dem.interface.bond.area=0.6e-4"
       " --set 'continuum.mesh.join={box: [[0.02175, -1, -1], [1, 1, 1]]}'"
-      " --set 'coupling.overlap.band.follow={margin: 4.0e-3, ahead: 8.0e-3, behind: 1.5e-3, until: 0.046}'"
+      " --set 'coupling.overlap.band.follow={margin: 4.0e-3, ahead: 8.0e-3, behind: 1.5e-3, until: 0.046, settle_time: 2.0e-5}'"
       " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json summary = read_json_file(out / "summary.json");
   const Json& moves = summary.at("zone_moves");
   std::size_t start_moves = 0;
-  double kept_residual = 0.0;
+  double kept_residual = 0.0, settled = 0.0;
   for (const Json& move : moves) {
     const double residual = move.at("displacement_residual").get<double>();
     if (move.at("particles_dropped").get<std::size_t>() > 0) {
       ++start_moves;
-      // Measured 4.5 % of the energy (12.8 % with the DEs put onto the continuum's field, 6.4 %
-      // with only the nodes the band leaves relaxed): the P1 arms, stiffer in bending than the
-      // DEM wake they take over, store more.
+      // Measured 3.4 % of the energy at the first (0.50 mJ of it the relaxation's damage
+      // dissipated; 4.5 % before the relaxation), 0.2 % at the second: the P1 arms, stiffer in
+      // bending than the DEM wake they take over, store more.
       EXPECT_LT(move.at("energy_jump").get<double>(), 0.07 * move.at("energy_before").get<double>());
-      // The settling: 40 us of steps (5498), the DEs within 6 mm of the new start; measured
-      // 0.46 mJ taken out of the DEs (1.7 % of the energy then).
-      EXPECT_EQ(move.at("settling_steps").get<long>(), 5498);
+      // The relaxation: the imbalance sum m |a - a_before|^2 down to 3.6e-3 and 4.0e-3 of what
+      // the moves left; x, y and the turn about z are free (the load lines hold z only).
+      EXPECT_EQ(move.at("relaxation_steps").get<int>(), 2000);
+      EXPECT_LT(move.at("relaxation_imbalance_after").get<double>(), 1e-2 * move.at("relaxation_imbalance_before").get<double>());
+      EXPECT_EQ(move.at("relaxation_free_rigid_motions").get<int>(), 3);
+      EXPECT_GE(move.at("relaxation_fracture").get<double>(), 0.0);
       EXPECT_GT(move.at("settling_particles").get<std::size_t>(), 100u);
-      EXPECT_GT(move.at("settling_dissipated").get<double>(), 0.0);
-      EXPECT_EQ(summary.at("zone_settling_dissipated").get<double>(), move.at("settling_dissipated").get<double>());
-      EXPECT_GT(residual, 1e-4);  // measured 3.7e-3: the DEs' offset, kept
+      settled += move.at("settling_dissipated").get<double>();
+      EXPECT_GT(residual, 1e-4);  // measured 3.6e-3 and 4.3e-3: the DEs' offset, kept
       EXPECT_LT(residual, 1e-2);
       kept_residual = residual;
     } else if (kept_residual > 0.0) {
-      EXPECT_NEAR(residual, kept_residual, 0.05 * kept_residual);  // measured within 1.3 %
+      EXPECT_NEAR(residual, kept_residual, 0.05 * kept_residual);
     } else {
       EXPECT_LT(residual, 1e-9);  // before: round-off
     }
   }
-  EXPECT_EQ(start_moves, 1u);  // at 0.756 ms, from 12 to 14.8 mm
-  // The balance closes with the settling's share booked (the DEs' kinetic energy as dissipated,
-  // 0.46 mJ, the projections back onto the constraint as the multipliers' work, 0.08 mJ):
-  // measured 2.6e-5 of the work (1.7e-5 without the settling).
+  // Measured two, at 0.756 and 0.757 ms (from 12 to 14.8, then 15.0 mm): the damage front runs
+  // ahead after the first, on these stiff P1 arms.
+  EXPECT_GE(start_moves, 1u);
+  EXPECT_GT(settled, 0.0);
+  EXPECT_EQ(summary.at("zone_settling_dissipated").get<double>(), settled);
+  // The balance closes with the jumps, the relaxation's damage and the settling booked: measured
+  // 1.7e-6 of the work (1.8e-2 with the relaxation's damage put back to where it was before it,
+  // which the first step then dissipated at once, more than the links gave up).
   double balance = 0.0, work = 0.0;
   for (const auto& row : test::read_csv(out / "series.csv"))
     balance = std::max(balance, std::abs(test::number(row, "E_balance"))), work = std::max(work, test::number(row, "W_external"));
-  EXPECT_LT(balance, 5e-5 * work);
+  EXPECT_LT(balance, 1e-5 * work);
 }
 
 // A band that follows a crack is built again at each move: its run is not checkpointed. On the
