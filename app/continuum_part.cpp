@@ -127,7 +127,7 @@ constexpr KeyDoc follow_keys[] = {
     {"until", KeyType::number, "m", Range::any(), "", "the furthest to: the band's to with the whole interface in it"},
     {"settle_time", KeyType::number, "s", Range::non_negative(), "0", "after a move of from: how long the DEs around the new start are kinetically damped (0: not; measured worse than relax_steps alone)"},
     {"settle_length", KeyType::number, "m", Range::positive(), "0.006", "after a move of from: the damped DEs reach this beyond the new from"},
-    {"relax_steps", KeyType::integer, "", Range::between(0, 1000000), "2000", "after a move of from: pseudo-time steps of the coupled state's dynamic relaxation toward the accelerations before the move (0: none)"},
+    {"relax_steps", KeyType::integer, "", Range::between(0, 1000000), "4000", "after a move of from: pseudo-time steps of the coupled state's dynamic relaxation toward the accelerations before the move (0: none)"},
 };
 constexpr SchemaSection continuum_sections[] = {
     {"continuum", "a continuum model", continuum_keys},
@@ -335,7 +335,7 @@ coupling::OverlapZone read_overlap(CaseNode overlap, const coupling::OverlapZone
                           f.number_or("behind", INFINITY, Range::positive(), "m"), f.number("until", Range::any(), "m"), axis, along, center, from, to,
                           width, f.number_or("settle_time", 0.0, Range::non_negative(), "s"),
                           f.number_or("settle_length", 6.0e-3, Range::positive(), "m"),
-                          static_cast<int>(f.integer_or("relax_steps", 2000, Range::between(0, 1000000))), f.where()};
+                          static_cast<int>(f.integer_or("relax_steps", 4000, Range::between(0, 1000000))), f.where()};
       if (follow->ahead <= follow->margin)
         f.fail("ahead", "expected more than margin (" + std::to_string(follow->margin) + " m): the band would move again at once");
       if (follow->until < to) f.fail("until", "expected the band's furthest end, at or beyond its to (" + std::to_string(to) + " m)");
