@@ -479,12 +479,12 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
     const auto mass_before = before.get<double>("continuum/lumped_mass"), mass_after = after.get<double>("continuum/lumped_mass");
     for (std::size_t d = 0; d < dof_rows.size(); ++d)
       if (dof_rows[d] >= 0 && mass_after[d] > mass_before[static_cast<std::size_t>(dof_rows[d])]) dof_rows[d] = -2;
-    carry_rows(was, target, "accelerations/dem/translation", de_rows);
-    carry_rows(was, target, "accelerations/dem/rotation", de_rows);
-    carry_rows(was, target, "accelerations/continuum", dof_rows);
-    zero_rows(target, "accelerations/dem/translation", de_rows);
-    zero_rows(target, "accelerations/dem/rotation", de_rows);
-    zero_rows(target, "accelerations/continuum", dof_rows);
+    for (const auto& [name, rows] : {std::pair{"accelerations/dem/translation", &de_rows},
+                                     std::pair{"accelerations/dem/rotation", &de_rows},
+                                     std::pair{"accelerations/continuum", &dof_rows}}) {
+      carry_rows(was, target, name, *rows);
+      zero_rows(target, name, *rows);
+    }
     report.relaxation = next->model->relax(current.dt, steps, target);
   }
 

@@ -172,7 +172,7 @@ void CoupledModel::save_accelerations(StateArchive& archive) const {
   const auto& f = continuum_.force();
   std::vector<double> nodes(f.size(), 0.0);
   for (std::size_t d = 0; d < f.size(); ++d)
-    if (inv_mass_c_[d] != 0.0 && !continuum_.is_fixed(static_cast<int>(d)))
+    if (continuum_dof_free(d))
       nodes[d] = f[d] * inv_mass_c_[d] - acc_c_(static_cast<Eigen::Index>(d / 3), static_cast<Eigen::Index>(d % 3));
   archive.put("accelerations/dem/translation", translation);
   archive.put("accelerations/dem/rotation", rotation);
@@ -186,15 +186,14 @@ CoupledModel::Relaxation CoupledModel::relax(double dt, int steps, const StateAr
   // What each DE and dof is to keep unbalanced: M a_target.
   std::vector<Vec3> force_offset = target.get<Vec3>("accelerations/dem/translation"),
                     torque_offset = target.get<Vec3>("accelerations/dem/rotation");
-  const std::vector<double> continuum_target = target.get<double>("accelerations/continuum");
+  std::vector<double> continuum_target = target.get<double>("accelerations/continuum");
   if (force_offset.size() != n || torque_offset.size() != n || continuum_target.size() != inv_mass_c_.size())
     throw std::logic_error("CoupledModel::relax: the target's accelerations are not this model's");
   for (std::size_t i = 0; i < n; ++i) force_offset[i] *= P.mass(i), torque_offset[i] *= P.inertia(i);
-  std::vector<double> continuum_offset = continuum_target;
   Relaxation out;
-  out.free_rigid_motions = remove_free_rigid_share(force_offset, torque_offset, continuum_offset);
+  out.free_rigid_motions = remove_free_rigid_share(force_offset, torque_offset, continuum_target);
   std::vector<char> moves(inv_mass_c_.size());
-  for (std::size_t d = 0; d < moves.size(); ++d) moves[d] = inv_mass_c_[d] != 0.0 && !continuum_.is_fixed(static_cast<int>(d));
+  for (std::size_t d = 0; d < moves.size(); ++d) moves[d] = continuum_dof_free(d);
 
   StateArchive start;
   save_state(start);
@@ -209,7 +208,7 @@ CoupledModel::Relaxation CoupledModel::relax(double dt, int steps, const StateAr
     dem_.relaxation_kick(h, force_offset, torque_offset);
     const auto& f = continuum_.force();
     for (std::size_t d = 0; d < vc.size(); ++d)
-      if (moves[d]) vc[d] += h * (f[d] * inv_mass_c_[d] - continuum_offset[d]);
+      if (moves[d]) vc[d] += h * (f[d] * inv_mass_c_[d] - continuum_target[d]);
     project_velocities();
   };
   const auto kinetic = [&] { return dem_.kinetic_energy() + continuum_.kinetic_energy(); };
@@ -244,12 +243,9 @@ CoupledModel::Relaxation CoupledModel::relax(double dt, int steps, const StateAr
   // gives up (the law's dissipation assumes small steps along its envelope).
   StateArchive relaxed;
   save_state(relaxed);
-  const auto ends_with = [](const std::string& name, const std::string& tail) {
-    return name.size() > tail.size() && name.compare(name.size() - tail.size(), tail.size(), tail) == 0;
-  };
   for (const auto& [name, entry] : relaxed.entries())
     if (name == "dem/particles/position" || name == "dem/particles/orientation" || name == "continuum/u" ||
-        (name.rfind("dem/bonds/", 0) == 0 && (ends_with(name, "/damage") || ends_with(name, "/dissipated"))))
+        (name.starts_with("dem/bonds/") && (name.ends_with("/damage") || name.ends_with("/dissipated"))))
       start.put_entry(name, entry);
   load_state(start);
   resume_from_set_state();
@@ -288,7 +284,6 @@ int CoupledModel::remove_free_rigid_share(std::vector<Vec3>& force_offset, std::
   const auto node_position = [&](std::size_t a) {
     return continuum_.nodes()[a] + Vec3{continuum_.displacement()[3 * a], continuum_.displacement()[3 * a + 1], continuum_.displacement()[3 * a + 2]};
   };
-  const auto held_c = [&](std::size_t d) { return inv_mass_c_[d] == 0.0 || continuum_.is_fixed(static_cast<int>(d)); };
   RigidModes modes;
   double mass = 0.0, second = 0.0;
   for (std::size_t i = 0; i < n; ++i) modes.centre += P.position[i] * P.mass(i), mass += P.mass(i);
@@ -318,7 +313,7 @@ int CoupledModel::remove_free_rigid_share(std::vector<Vec3>& force_offset, std::
     }
   }
   for (std::size_t d = 0; d < 3 * nn; ++d) {
-    if (!held_c(d)) continue;
+    if (continuum_dof_free(d)) continue;
     for (int j = 0; j < 6; ++j) value[j] = modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)];
     held += value * value.transpose();
   }
@@ -348,7 +343,7 @@ int CoupledModel::remove_free_rigid_share(std::vector<Vec3>& force_offset, std::
   }
   const auto& f = continuum_.force();
   for (std::size_t d = 0; d < 3 * nn; ++d) {
-    if (held_c(d)) continue;
+    if (!continuum_dof_free(d)) continue;
     Vector6 phi;
     for (int j = 0; j < 6; ++j) phi[j] = modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)];
     const Vector6 phi_free = basis.transpose() * phi;
@@ -366,7 +361,7 @@ int CoupledModel::remove_free_rigid_share(std::vector<Vec3>& force_offset, std::
     torque_offset[i] += alpha * P.inertia(i);
   }
   for (std::size_t d = 0; d < 3 * nn; ++d) {
-    if (held_c(d)) continue;
+    if (!continuum_dof_free(d)) continue;
     double a = 0.0;
     for (int j = 0; j < 6; ++j) a += modes.velocity(j, node_position(d / 3))[static_cast<int>(d % 3)] * c6[j];
     continuum_target[d] += a;

@@ -254,6 +254,8 @@ class CoupledModel {
   void put_state_on_constraint();
   // Both models' velocities onto G v = 0 (the mass-weighted projection); lambda_ as scratch.
   void project_velocities();
+  // Whether continuum dof d moves on its own: neither fixed nor held for the coupling.
+  bool continuum_dof_free(std::size_t d) const { return inv_mass_c_[d] != 0.0 && !continuum_.is_fixed(static_cast<int>(d)); }
   // relax's targets (M a_target, per DE force and torque; per continuum dof the acceleration)
   // less their share on the rigid motions that no held dof stops (see relax).
   // Returns how many independent rigid motions were free.
