@@ -148,6 +148,7 @@ void CoupledModel::project_velocities() {
 }
 
 void CoupledModel::resume_from_set_state() {
+  macro_origin_ = steps_;  // a state is set from outside between two macro steps (header)
   dem_.restart_forces();
   continuum_.compute_forces();
   put_state_on_constraint();
@@ -542,7 +543,7 @@ double CoupledModel::continuum_kinetic_energy() const {
   // Inside a macro step of the continuum's substeps (theory.md#continuum-substeps) its velocities
   // carry the opening impulse m dt/2 M^-1 f whole; j steps in, the force's share so far is j dt,
   // so the energy is taken at v - (m/2 - j) dt M^-1 f, as if the force acted evenly.
-  const int m = options_.continuum_substeps, j = static_cast<int>(steps_ % m);
+  const int m = options_.continuum_substeps, j = macro_phase();
   return continuum_.kinetic_energy(j == 0 ? 0.0 : -(0.5 * m - j) * dem_.last_dt());
 }
 
@@ -613,6 +614,7 @@ void CoupledModel::save_state(StateArchive& archive) const {
   archive.put("coupling/work", coupling_work_);
   archive.put("coupling/time", time_);
   archive.put("coupling/steps", std::int64_t{steps_});
+  archive.put("coupling/macro_origin", std::int64_t{macro_origin_});
   archive.put("coupling/breaks_looked_at", static_cast<std::int64_t>(breaks_looked_at_));
   archive.put("coupling/held_looked_at", static_cast<std::int64_t>(held_looked_at_));
 }
@@ -633,6 +635,7 @@ void CoupledModel::load_state(const StateArchive& archive) {
   coupling_work_ = archive.number("coupling/work");
   time_ = archive.number("coupling/time");
   steps_ = archive.integer("coupling/steps");
+  macro_origin_ = archive.has("coupling/macro_origin") ? archive.integer("coupling/macro_origin") : 0;  // 0 before it was kept
   breaks_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/breaks_looked_at"));
   held_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/held_looked_at"));
 }

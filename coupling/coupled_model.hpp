@@ -194,7 +194,8 @@ class CoupledModel {
   void load_state(const StateArchive& archive);
   // After both models' states were set from outside between two steps (a zone that moved,
   // app/zone_move.hpp: DEs and nodes carried over from another scene, the new ones interpolated):
-  // their forces again, the velocities onto the constraint and its force, as at construction.
+  // their forces again, the velocities onto the constraint and its force, as at construction;
+  // a macro step of the continuum's substeps opens at the next step, whatever the step count.
   void resume_from_set_state();
   // Kinetic damping between two macro steps (opens_macro_step(), where the continuum's
   // velocities are in step with its forces): the DEs `ids` stop (DemModel::arrest, their kinetic
@@ -236,7 +237,7 @@ class CoupledModel {
   Relaxation relax(double dt, int steps, const StateArchive& target);
   // Whether the next step opens a macro step of options.continuum_substeps (its continuum force
   // is then that of the present state): where a state may be set from outside.
-  bool opens_macro_step() const { return steps_ % options_.continuum_substeps == 0; }
+  bool opens_macro_step() const { return macro_phase() == 0; }
 
   const OverlapZone& zone() const { return zone_; }
   const CouplingOperators& operators() const { return ops_; }
@@ -267,7 +268,9 @@ class CoupledModel {
   void kick_to_trial(double dt);
   // Whether the step in progress is the last of a macro step of the continuum's substeps (during
   // a step, opens_macro_step() says whether it is the first; both when there is one substep).
-  bool closes_macro_step() const { return (steps_ + 1) % options_.continuum_substeps == 0; }
+  bool closes_macro_step() const { return macro_phase() + 1 == options_.continuum_substeps; }
+  // The steps of the present macro step done so far, counted from macro_origin_.
+  int macro_phase() const { return static_cast<int>((steps_ - macro_origin_) % options_.continuum_substeps); }
   void solve_and_correct(double dt);  // solve_multipliers + correct_velocities
 
   void make_overlap_quadrature_consistent();
@@ -298,6 +301,11 @@ class CoupledModel {
   double coupling_work_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
+  // The step the macro steps count from: 0, or the one a state was set from outside at
+  // (resume_from_set_state). A following band's moved scene may take another number of substeps
+  // than the scene its state came from (continuum_substeps: auto), and the run's step count
+  // need not be a multiple of it.
+  long macro_origin_ = 0;
 };
 
 }  // namespace arlequin::coupling

@@ -156,3 +156,58 @@ TEST(CouplingRelaxation, AFreeBarsNetForceIsLeftToTheRun) {
 }
 
 }  // namespace
+
+// A state set from outside opens a macro step of the model it is set into: with
+// continuum_substeps: auto a following band's moved scene may take another number of substeps
+// than the scene its state came from, at a step count that is no multiple of it. The hanging
+// bar's model with the continuum's force every second step, four steps into a motion, its state
+// set into the same bar with every third (step count 4): that model's next steps are, to the
+// bit, those of the same state set with the step count 0, where the macro steps begin anyway.
+TEST(CouplingRelaxation, AStateSetFromOutsideOpensAMacroStep) {
+  constexpr double X1 = 20.0, X2 = 28.0, L = 80.0, v0 = 0.01;
+  const std::string mesh = write_box_mesh("relax_macro_step", X1, static_cast<int>(L - X1), 1.0, 1, 1.0, 1, 1.0);
+  struct Bar {
+    std::unique_ptr<continuum::ContinuumSolver> cont;
+    dem::DemModel dem;
+    std::unique_ptr<CoupledModel> model;
+  };
+  const auto bar = [&mesh](int substeps) {
+    auto b = std::make_unique<Bar>();
+    b->cont = make_continuum("fe", mesh, 1.0, 0.0, 1.0);
+    b->cont->fix("xmax", {true, true, true}, [](const Vec3&, double) { return Vec3{}; });
+    build_four_lines(b->dem, static_cast<int>(X2) + 1, 1.0, 1.0, 1.0, 1.0);
+    CoupledOptions options;
+    options.continuum_substeps = substeps;
+    const OverlapZone zone = OverlapZone::box({{X1, -1, -1}, {X2, 2, 2}}, 0, true, {WeightShape::linear, 0.05, 0.5});
+    b->model = std::make_unique<CoupledModel>(b->dem, *b->cont, zone, options);
+    return b;
+  };
+  // A motion with strain: velocities growing along the bar, then four steps at m = 2.
+  const auto first = bar(2);
+  for (std::size_t i = 0; i < first->dem.particles.size(); ++i) first->dem.particles.velocity[i] = {v0 * first->dem.particles.reference[i].x / L, 0.0, 0.0};
+  auto& vc = first->cont->velocity();
+  for (std::size_t d = 0; d < vc.size(); d += 3)
+    if (!first->cont->is_fixed(static_cast<int>(d))) vc[d] = v0 * first->cont->nodes()[d / 3].x / L;
+  const auto third = bar(3), from_zero = bar(3);
+  const double dt = 0.9 * std::min(first->model->critical_time_step(), third->model->critical_time_step());
+  for (int n = 0; n < 4; ++n) first->model->step(dt);
+  StateArchive state;
+  first->model->save_state(state);
+  third->model->load_state(state);
+  third->model->resume_from_set_state();
+  state.put("coupling/steps", std::int64_t{0});
+  from_zero->model->load_state(state);
+  from_zero->model->resume_from_set_state();
+  EXPECT_TRUE(third->model->opens_macro_step());
+  for (int n = 0; n < 7; ++n) third->model->step(dt), from_zero->model->step(dt);
+  for (std::size_t i = 0; i < third->dem.particles.size(); ++i) {
+    EXPECT_EQ(third->dem.particles.position[i].x, from_zero->dem.particles.position[i].x) << "DE " << i;
+    EXPECT_EQ(third->dem.particles.velocity[i].x, from_zero->dem.particles.velocity[i].x) << "DE " << i;
+  }
+  for (std::size_t d = 0; d < vc.size(); ++d) {
+    EXPECT_EQ(third->cont->displacement()[d], from_zero->cont->displacement()[d]) << "dof " << d;
+    EXPECT_EQ(third->cont->velocity()[d], from_zero->cont->velocity()[d]) << "dof " << d;
+  }
+  EXPECT_EQ(third->model->energies().total(), from_zero->model->energies().total());
+  EXPECT_FALSE(third->model->opens_macro_step());  // seven steps: one into the third macro step
+}
