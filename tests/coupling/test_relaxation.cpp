@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
 
 #include "coupling_test_util.hpp"
 
@@ -15,20 +17,38 @@ using namespace arlequin::coupling::testing;
 
 namespace {
 
-// The 1D bar of four DE lines on [0, X2] (E = rho = 1, a = b = 1, nu = 0), coupled over
-// [X1, X2] to the one-cell-thick mesh on [X1, L], held at x = L. Every DE and node is to keep
+// The bar of the tests below: four DE lines on [0, X2] (E = rho = 1, a = b = 1, nu = 0),
+// coupled over [X1, X2] (linear weights) to the one-cell-thick mesh on [X1, L], held at x = L
+// when `held`, its internal force every `substeps` steps.
+constexpr double X1 = 20.0, X2 = 28.0, L = 80.0;
+struct CoupledBar {
+  std::unique_ptr<continuum::ContinuumSolver> cont;
+  dem::DemModel dem;
+  std::unique_ptr<CoupledModel> model;
+};
+std::unique_ptr<CoupledBar> coupled_bar(const std::string& mesh, bool held, int substeps = 1) {
+  auto bar = std::make_unique<CoupledBar>();
+  bar->cont = make_continuum("fe", mesh, 1.0, 0.0, 1.0);
+  if (held) bar->cont->fix("xmax", {true, true, true}, [](const Vec3&, double) { return Vec3{}; });
+  build_four_lines(bar->dem, static_cast<int>(X2) + 1, 1.0, 1.0, 1.0, 1.0);
+  const OverlapZone zone = OverlapZone::box({{X1, -1, -1}, {X2, 2, 2}}, 0, true, {WeightShape::linear, 0.05, 0.5});
+  CoupledOptions options;
+  options.continuum_substeps = substeps;
+  bar->model = std::make_unique<CoupledModel>(bar->dem, *bar->cont, zone, options);
+  return bar;
+}
+std::string bar_mesh(const std::string& name) { return write_box_mesh(name, X1, static_cast<int>(L - X1), 1.0, 1, 1.0, 1, 1.0); }
+
+// The bar held at x = L. Every DE and node is to keep
 // m a0 unbalanced along x: the bar hangs under its own weight with g = -a0, so the stress is
 // rho a0 x from the free end x = 0 and u(0) = -rho a0 L^2 / (2 E) (d sigma / dx = rho a0,
 // sigma(0) = 0, u(L) = 0).
 TEST(CouplingRelaxation, ABarRelaxesToItsOwnWeightsEquilibriumAndKeepsItsMotion) {
-  constexpr double X1 = 20.0, X2 = 28.0, L = 80.0, a0 = 1e-5, v0 = 0.01;
-  const std::string mesh = write_box_mesh("relax_bar", X1, static_cast<int>(L - X1), 1.0, 1, 1.0, 1, 1.0);
-  auto cont = make_continuum("fe", mesh, 1.0, 0.0, 1.0);
-  cont->fix("xmax", {true, true, true}, [](const Vec3&, double) { return Vec3{}; });
-  dem::DemModel dem;
-  build_four_lines(dem, static_cast<int>(X2) + 1, 1.0, 1.0, 1.0, 1.0);
-  const OverlapZone zone = OverlapZone::box({{X1, -1, -1}, {X2, 2, 2}}, 0, true, {WeightShape::linear, 0.05, 0.5});
-  CoupledModel model(dem, *cont, zone, CoupledOptions{});
+  constexpr double a0 = 1e-5, v0 = 0.01;
+  const auto bar = coupled_bar(bar_mesh("relax_bar"), true);
+  auto& cont = bar->cont;
+  dem::DemModel& dem = bar->dem;
+  CoupledModel& model = *bar->model;
   const double dt = 0.9 * model.critical_time_step();
   // A motion on the constraint (the same in both models where they overlap) that the relaxation
   // must give back: every free dof at v0 along x.
@@ -108,13 +128,11 @@ TEST(CouplingRelaxation, ABarRelaxesToItsOwnWeightsEquilibriumAndKeepsItsMotion)
 // (a0 - c) x on [0, X1], then falling by c per unit length to 0 at x = L. Its centre of mass
 // stays where it was.
 TEST(CouplingRelaxation, AFreeBarsNetForceIsLeftToTheRun) {
-  constexpr double X1 = 20.0, X2 = 28.0, L = 80.0, a0 = 1e-5;
-  const std::string mesh = write_box_mesh("relax_free_bar", X1, static_cast<int>(L - X1), 1.0, 1, 1.0, 1, 1.0);
-  auto cont = make_continuum("fe", mesh, 1.0, 0.0, 1.0);
-  dem::DemModel dem;
-  build_four_lines(dem, static_cast<int>(X2) + 1, 1.0, 1.0, 1.0, 1.0);
-  const OverlapZone zone = OverlapZone::box({{X1, -1, -1}, {X2, 2, 2}}, 0, true, {WeightShape::linear, 0.05, 0.5});
-  CoupledModel model(dem, *cont, zone, CoupledOptions{});
+  constexpr double a0 = 1e-5;
+  const auto bar = coupled_bar(bar_mesh("relax_free_bar"), false);
+  auto& cont = bar->cont;
+  dem::DemModel& dem = bar->dem;
+  CoupledModel& model = *bar->model;
   const double dt = 0.9 * model.critical_time_step();
   const std::size_t n_dem = dem.particles.size(), n_dof = cont->velocity().size();
   double pulled = 0.0, mass = 0.0, moment_before = 0.0;
@@ -155,8 +173,6 @@ TEST(CouplingRelaxation, AFreeBarsNetForceIsLeftToTheRun) {
               (moment_after - moment_before) / mass);
 }
 
-}  // namespace
-
 // A state set from outside opens a macro step of the model it is set into: with
 // continuum_substeps: auto a following band's moved scene may take another number of substeps
 // than the scene its state came from, at a step count that is no multiple of it. The hanging
@@ -164,31 +180,15 @@ TEST(CouplingRelaxation, AFreeBarsNetForceIsLeftToTheRun) {
 // set into the same bar with every third (step count 4): that model's next steps are, to the
 // bit, those of the same state set with the step count 0, where the macro steps begin anyway.
 TEST(CouplingRelaxation, AStateSetFromOutsideOpensAMacroStep) {
-  constexpr double X1 = 20.0, X2 = 28.0, L = 80.0, v0 = 0.01;
-  const std::string mesh = write_box_mesh("relax_macro_step", X1, static_cast<int>(L - X1), 1.0, 1, 1.0, 1, 1.0);
-  struct Bar {
-    std::unique_ptr<continuum::ContinuumSolver> cont;
-    dem::DemModel dem;
-    std::unique_ptr<CoupledModel> model;
-  };
-  const auto bar = [&mesh](int substeps) {
-    auto b = std::make_unique<Bar>();
-    b->cont = make_continuum("fe", mesh, 1.0, 0.0, 1.0);
-    b->cont->fix("xmax", {true, true, true}, [](const Vec3&, double) { return Vec3{}; });
-    build_four_lines(b->dem, static_cast<int>(X2) + 1, 1.0, 1.0, 1.0, 1.0);
-    CoupledOptions options;
-    options.continuum_substeps = substeps;
-    const OverlapZone zone = OverlapZone::box({{X1, -1, -1}, {X2, 2, 2}}, 0, true, {WeightShape::linear, 0.05, 0.5});
-    b->model = std::make_unique<CoupledModel>(b->dem, *b->cont, zone, options);
-    return b;
-  };
+  constexpr double v0 = 0.01;
+  const std::string mesh = bar_mesh("relax_macro_step");
   // A motion with strain: velocities growing along the bar, then four steps at m = 2.
-  const auto first = bar(2);
+  const auto first = coupled_bar(mesh, true, 2);
   for (std::size_t i = 0; i < first->dem.particles.size(); ++i) first->dem.particles.velocity[i] = {v0 * first->dem.particles.reference[i].x / L, 0.0, 0.0};
   auto& vc = first->cont->velocity();
   for (std::size_t d = 0; d < vc.size(); d += 3)
     if (!first->cont->is_fixed(static_cast<int>(d))) vc[d] = v0 * first->cont->nodes()[d / 3].x / L;
-  const auto third = bar(3), from_zero = bar(3);
+  const auto third = coupled_bar(mesh, true, 3), from_zero = coupled_bar(mesh, true, 3);
   const double dt = 0.9 * std::min(first->model->critical_time_step(), third->model->critical_time_step());
   for (int n = 0; n < 4; ++n) first->model->step(dt);
   StateArchive state;
@@ -211,3 +211,5 @@ TEST(CouplingRelaxation, AStateSetFromOutsideOpensAMacroStep) {
   EXPECT_EQ(third->model->energies().total(), from_zero->model->energies().total());
   EXPECT_FALSE(third->model->opens_macro_step());  // seven steps: one into the third macro step
 }
+
+}  // namespace
