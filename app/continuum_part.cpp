@@ -11,6 +11,7 @@
 #include "common/error.hpp"
 #include "common/fields_writer.hpp"
 #include "common/json.hpp"
+#include "common/rise.hpp"
 #include "continuum/continuum_solver.hpp"
 #include "continuum/registry.hpp"
 #include "coupling/coupled_model.hpp"
@@ -70,7 +71,7 @@ constexpr KeyDoc continuum_boundary_keys[] = {
     {"type", KeyType::choice, "", {}, "", "what it imposes", "fixed | displacement | velocity | traction"},
     {"value", KeyType::vec3, "(m, m/s or Pa by type)", {}, "", "the imposed displacement, velocity or traction"},
     {"components", KeyType::strings, "", {}, "(x, y, z)", "the components it acts on"},
-    {"rise", KeyType::number, "s", Range::non_negative(), "0", "velocity: time over which it rises linearly from 0"},
+    {"rise", KeyType::number, "s", Range::non_negative(), "0", "velocity: time over which it rises from 0, as (1 - cos(pi t / rise)) / 2"},
     {"duration", KeyType::number, "s", Range::positive(), "inf", "velocity: time after which it stops"},
 };
 constexpr KeyDoc coupling_keys[] = {
@@ -663,9 +664,12 @@ class Part final : public ContinuumPart {
     if (bc.kind == "displacement") {
       g = [u = bc.value](const Vec3&, double) { return u; };
     } else if (bc.kind == "velocity") {
-      // Velocity v min(t / rise, 1) until `duration`, then held: g(t) is its integral.
-      const auto travel = [rise = bc.rise](double t) { return t < rise ? 0.5 * t * t / rise : t - 0.5 * rise; };
-      g = [v = bc.value, duration = bc.duration, travel](const Vec3&, double t) { return v * travel(std::min(t, duration)); };
+      // Velocity v with the DEM's rise (common/rise.hpp) until `duration`, then held: g(t) is its
+      // integral. One rise for both: a coupled run's load strips then move as the pure DEM's load
+      // DEs do.
+      g = [v = bc.value, duration = bc.duration, rise = bc.rise](const Vec3&, double t) {
+        return v * rise_travel(std::min(t, duration), rise);
+      };
     }
     solver_->fix(group, bc.components, g);
     const auto dofs = coupling::group_dofs(*solver_, group, bc.components);

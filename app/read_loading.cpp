@@ -29,7 +29,7 @@ constexpr KeyDoc boundary_keys[] = {
     {"type", KeyType::choice, "", {}, "", "what it imposes", "fixed | velocity | displacement | force | free"},
     {"value", KeyType::vec3, "(m/s, m or N by type)", {}, "", "the imposed velocity, displacement or total force"},
     {"components", KeyType::strings, "", {}, "(x, y, z)", "the components it acts on"},
-    {"rise", KeyType::number, "s", Range::non_negative(), "0", "time over which the value rises linearly from 0"},
+    {"rise", KeyType::number, "s", Range::non_negative(), "0", "velocity: time over which it rises from 0, as (1 - cos(pi t / rise)) / 2"},
     {"ramp", KeyType::number, "s", Range::positive(), "(none)", "displacement: time over which it is reached"},
     {"rotation", KeyType::choice, "", {}, "free", "whether the DEs' rotations are held", "free | fixed"},
 };

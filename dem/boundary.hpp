@@ -3,7 +3,8 @@
 //
 //   fixed         x = x_ref, v = 0, rotation locked (clamped)
 //   velocity      v = value (m/s); x = x_ref + value t; with a rise time (s) the velocity grows
-//                 as value (1 - cos(pi t / rise)) / 2 first (no step: no ringing), x its integral
+//                 as value (1 - cos(pi t / rise)) / 2 first (common/rise.hpp: no jump of the
+//                 velocity or the acceleration, no ringing), x its integral
 //   displacement  linear ramp to value (m) over ramp (s), then held: v = value/ramp, then 0
 //   force         total force value (N) shared equally by the group's DEs (a dead load)
 //   free          nothing imposed; declares that the group must not be constrained
