@@ -727,7 +727,7 @@ RunResult run_scene(Scene& built, const RunOptions& options) {
                  steps_done, current_time(), place.from, place.to, move.des, move.des_added, move.des_dropped, move.nodes_added, move.energy_jump(),
                  move.energy_before, move.setup_seconds);
     if (move.relaxation.steps > 0)
-      std::fprintf(stderr, "  relaxed in %d pseudo-time steps: imbalance sum m|a - a_before|^2 %.3g -> %.3g J/s^2 (%d free rigid motions)\n",
+      std::fprintf(stderr, "  relaxed in %d pseudo-time steps: imbalance sum m|a - a_target|^2 %.3g -> %.3g J/s^2 (%d free rigid motions)\n",
                    move.relaxation.steps, move.relaxation.imbalance_before, move.relaxation.imbalance_after, move.relaxation.free_rigid_motions);
   };
 

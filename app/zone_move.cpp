@@ -463,28 +463,21 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
   next->model->load_state(after);
   take_motion_from_continuum(co, before.get<double>("continuum/u"), before.get<double>("continuum/v"), next->dem.particles, old_of_new);
   next->model->resume_from_set_state();
-  // A move of the start hands the wake's stress to the continuum in one step: the state is
-  // relaxed toward the accelerations each DE and node had before (those new to the zone: their
-  // own now), so that the move leaves no force it did not find; but toward rest where the weight
-  // of a DE or node rose: what it had was the coupling's, the other model's motion followed with
-  // a mass too small to carry it, which its new mass would turn into a force the state never
-  // had (docs/decisions.md#d56).
+  // A move of the start hands the wake's stress to the continuum in one step: the state is then
+  // relaxed to its equilibrium at the present load, every DE both scenes have and every continuum
+  // node toward rest, the DEs new to the zone toward their own accelerations as set (they took the
+  // continuum's motion; what their packing's forces make of it is not the move's). Not toward the
+  // accelerations before: where the move dropped or reweighted the DEs a node or DE was tied to,
+  // those carried the coupling's force from DEs that are gone, a force the arms then balanced at
+  // the load strips (docs/decisions.md#d56).
   if (const int steps = follow_of(*next).relax_steps; start_moved && steps > 0) {
-    StateArchive was, target;
-    current.model->save_accelerations(was);
+    StateArchive target;
     next->model->save_accelerations(target);
-    std::vector<long> de_rows = old_of_new, dof_rows = old_dof_of_new;
-    for (std::size_t i = 0; i < pn.size(); ++i)
-      if (de_rows[i] >= 0 && pn.mass(i) > po.mass(static_cast<std::size_t>(de_rows[i]))) de_rows[i] = -2;
-    const auto mass_before = before.get<double>("continuum/lumped_mass"), mass_after = after.get<double>("continuum/lumped_mass");
-    for (std::size_t d = 0; d < dof_rows.size(); ++d)
-      if (dof_rows[d] >= 0 && mass_after[d] > mass_before[static_cast<std::size_t>(dof_rows[d])]) dof_rows[d] = -2;
-    for (const auto& [name, rows] : {std::pair{"accelerations/dem/translation", &de_rows},
-                                     std::pair{"accelerations/dem/rotation", &de_rows},
-                                     std::pair{"accelerations/continuum", &dof_rows}}) {
-      carry_rows(was, target, name, *rows);
-      zero_rows(target, name, *rows);
-    }
+    std::vector<long> kept(pn.size());
+    for (std::size_t i = 0; i < pn.size(); ++i) kept[i] = old_of_new[i] >= 0 ? -2 : -1;
+    zero_rows(target, "accelerations/dem/translation", kept);
+    zero_rows(target, "accelerations/dem/rotation", kept);
+    target.put("accelerations/continuum", std::vector<double>(target.get<double>("accelerations/continuum").size(), 0.0));
     report.relaxation = next->model->relax(current.dt, steps, target);
   }
 

@@ -41,9 +41,9 @@
 //        (SceneModel::resume_from_set_state). The crack sensors keep the pre-crack tip of the
 //        scene as first built, and the energy dissipated by links left behind;
 //      * after a move of `from`, follow.relax_steps of the coupled state's dynamic relaxation
-//        (SceneModel::relax) toward the constrained accelerations each DE and continuum dof had
-//        before (those new to the zone: their own; those whose mass rose with their weight: rest),
-//        so that the move leaves no force it did not find (ZoneMove::relaxation).
+//        (SceneModel::relax) to its equilibrium at the present load: every continuum dof and
+//        every DE both scenes have toward rest, the DEs new to the zone toward their own
+//        accelerations as set (ZoneMove::relaxation).
 //    Only between two steps where current.model->accepts_set_state(). InputError (naming the
 //    follow section) where the case cannot move: no interface, a join that is not a box.
 //  - The move changes the total energy (DEs and links dropped behind and added ahead, weights
