@@ -166,11 +166,11 @@ TEST(ZoneMove, AGrowingBandFollowsTheWholeBandsDcb) {
 // A move of the band's start (follow with `behind`) on the reduced DCB: the DEM's wake behind the
 // tip goes to the continuum. The coupled DEs stay where they were, so the displacement
 // constraint keeps the DEs' offset from the continuum's field (its residual stays as the next
-// moves find it). Each move of the start relaxes the coupled state toward the forces before it
-// (follow.relax_steps, 4000 by default) to its equilibrium at the present load, which the DEs'
-// damage follows, and the damage front stays where the crack put it; the DEs around the new start
-// then settle (kinetic damping, here over 20 us to cover it: off by default). What both change or
-// take out is booked, and the balance closes.
+// moves find it). Each move of the start relaxes the coupled state (follow.relax_steps, 4000 by
+// default) to its equilibrium at the present load, which the DEs' damage follows, and the damage
+// front stays where the crack put it; the DEs around the new start then settle (kinetic damping,
+// here over 20 us to cover it: off by default). What both change or take out is booked, and the
+// balance closes.
 TEST(ZoneMove, MovingTheStartLeavesTheCoupledDesWhereTheyAre) {
   const auto out = test::scratch_dir("zone_move_start");
   const auto r = test::run_arlequin(
