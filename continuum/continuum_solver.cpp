@@ -124,6 +124,7 @@ void ContinuumSolver::set_weight(ScalarFunction alpha) {
   const Vec3& share = materials_.front().inertia;  // the same for every material (constructor)
   dof_mass_.resize(3 * mass_.size());
   for (std::size_t d = 0; d < dof_mass_.size(); ++d) dof_mass_[d] = mass_[d / 3] * share[static_cast<int>(d % 3)];
+  update_kick_inverse_mass();
   stiffness_current_ = false;
 }
 
@@ -281,6 +282,7 @@ void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> componen
       else
         it->g = g;  // the later BC on a shared node wins
       is_fixed_[dof] = 1;
+      kick_inverse_mass_[dof] = 0.0;
       u_[dof] = prescribed(*it, t_);
     }
 }
@@ -399,35 +401,36 @@ void ContinuumSolver::compute_forces() {
   });
 }
 
+void ContinuumSolver::update_kick_inverse_mass() {
+  kick_inverse_mass_.resize(dof_mass_.size());
+  for (std::size_t d = 0; d < dof_mass_.size(); ++d) kick_inverse_mass_[d] = is_fixed_[d] ? 0.0 : 1.0 / dof_mass_[d];
+}
+
+// The kick and the drift update every dof without a branch or a division, so that the drift and
+// an undamped kick run in vector lanes: a held dof's kick is by 0 (kick_inverse_mass_), and its
+// drift is overwritten by its prescribed value (its velocity the one that reaches that value).
 void ContinuumSolver::kick(double dt) {
   const long n = static_cast<long>(v_.size());
+  const auto dv = [this, dt](long d) { return dt * f_[d] * kick_inverse_mass_[d]; };
   if (!(damping_ > 0.0)) {
-    for_each_index(n, n > parallel_threshold, [this, dt](long d) {
-      if (!is_fixed_[d]) v_[d] += dt * f_[d] / dof_mass_[d];
-    });
+    for_each_index(n, n > parallel_threshold, [this, &dv](long d) { v_[d] += dv(d); });
     return;
   }
   // A kick changes a dof's kinetic energy by dt f (v + v')/2 exactly; the damping force's share
-  // of that is the energy it dissipated (as DemModel::kick).
-  dissipated_ -= fixed_order_sum(n, parallel_threshold, kick_partial_, [this, dt](long d) {
-    if (is_fixed_[d]) return 0.0;
+  // of that is the energy it dissipated (as DemModel::kick; 0 on held dofs, compute_forces).
+  dissipated_ -= fixed_order_sum(n, parallel_threshold, kick_partial_, [this, dt, &dv](long d) {
     const double v = v_[d];
-    v_[d] += dt * f_[d] / dof_mass_[d];
+    v_[d] += dv(d);
     return dt * damping_force_[d] * 0.5 * (v + v_[d]);
   });
 }
 
 void ContinuumSolver::drift(double dt) {
   t_ += dt;
+  for (const Fixed& f : fixed_) v_[f.dof] = (prescribed(f, t_) - u_[f.dof]) / dt;  // from u before the drift
   const long n = static_cast<long>(u_.size());
-  for_each_index(n, n > parallel_threshold, [this, dt](long d) {
-    if (!is_fixed_[d]) u_[d] += dt * v_[d];
-  });
-  for (const Fixed& f : fixed_) {
-    const double g = prescribed(f, t_);
-    v_[f.dof] = (g - u_[f.dof]) / dt;
-    u_[f.dof] = g;
-  }
+  for_each_index(n, n > parallel_threshold, [this, dt](long d) { u_[d] += dt * v_[d]; });
+  for (const Fixed& f : fixed_) u_[f.dof] = prescribed(f, t_);
 }
 
 void ContinuumSolver::begin_step_work() {

@@ -264,6 +264,8 @@ class ContinuumSolver {
   std::vector<Fixed> fixed_;
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)
   std::vector<char> is_fixed_;  // per dof
+  std::vector<double> kick_inverse_mass_;  // per dof: 1 / dof_mass_, 0 where fixed (what a kick multiplies f by)
+  void update_kick_inverse_mass();
   std::vector<Traction> tractions_;
   Field u_, v_, f_;
   double t_ = 0.0;

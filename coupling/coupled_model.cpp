@@ -137,7 +137,7 @@ void CoupledModel::put_state_on_constraint() {
   }
   Matrix3 ac = Eigen::Map<const Matrix3>(continuum_.force().data(), nn, 3).cwiseProduct(
       Eigen::Map<const Matrix3>(inv_mass_c_.data(), nn, 3));
-  solver_->project(ad, ac, acc_d_, acc_c_, mu_);
+  solver_->project(ad, ac, acc_d_, acc_c_, mu_, &constraint_force_);
 }
 
 void CoupledModel::project_velocities() {
@@ -476,8 +476,13 @@ void CoupledModel::advance_models(double dt) {
   if (opens_macro_step()) continuum_.kick(0.5 * options_.continuum_substeps * dt);
   continuum_.drift(dt);
   if (closes_macro_step()) continuum_.compute_forces();
-  gather_dem_velocity(vd_);
-  solver_->residual(vd_, continuum_velocity(), drift_residual_);
+  // The drift velocities v(n+1/2) where the multipliers act, for their work (solve_and_correct).
+  gather_dem_velocity(vd_drift_);
+  const std::vector<int>& nodes = solver_->corrected_nodes();
+  const Eigen::Map<Matrix3> vc = continuum_velocity();
+  vc_drift_.resize(static_cast<Eigen::Index>(nodes.size()), 3);
+  for_each_index(vc_drift_.rows(), vc_drift_.rows() > parallel_threshold,
+                 [&](long k) { vc_drift_.row(k) = vc.row(nodes[static_cast<std::size_t>(k)]); });
 }
 
 void CoupledModel::kick_to_trial(double dt) {
@@ -505,15 +510,29 @@ std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
 
 void CoupledModel::solve_and_correct(double dt) {
   gather_dem_velocity(vd_);
-  solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_);
+  solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_, &constraint_force_next_);
   scatter_dem_velocity(vd_);
-  const double h = 0.5 * dt;
-  acc_d_ /= h;
-  for (int n : solver_->corrected_nodes()) acc_c_.row(n) /= h;  // 0 elsewhere (MultiplierSolver::project)
-  lambda_ /= h;  // now mu(n+1)
-  // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2).
-  coupling_work_ -= 0.5 * dt * ((mu_ + lambda_).cwiseProduct(drift_residual_)).sum();
+  const double inv_h = 2.0 / dt;  // the corrections and multipliers of the half step dt/2, per unit time
+  const std::vector<int>& nodes = solver_->corrected_nodes();
+  acc_d_ *= inv_h;
+  constraint_force_next_.dem *= inv_h;
+  lambda_ *= inv_h;  // now mu(n+1)
+  // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2),
+  // as G^T (mu(n) + mu(n+1)) . v(n+1/2) over the coupled DEs and the nodes G reaches.
+  double power = (constraint_force_.dem + constraint_force_next_.dem).cwiseProduct(vd_drift_).sum();
+  Matrix3& fc = constraint_force_next_.continuum;
+  const Matrix3& fc_before = constraint_force_.continuum;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {  // 0 elsewhere (MultiplierSolver::project)
+    const int n = nodes[k];
+    for (int c = 0; c < 3; ++c) {
+      acc_c_(n, c) *= inv_h;
+      fc(n, c) *= inv_h;
+      power += (fc_before(n, c) + fc(n, c)) * vc_drift_(static_cast<Eigen::Index>(k), c);
+    }
+  }
+  coupling_work_ -= 0.5 * dt * power;
   mu_.swap(lambda_);
+  std::swap(constraint_force_, constraint_force_next_);
 }
 
 // sum m |a|^2 with a the constrained accelerations (rotations included).
@@ -556,7 +575,6 @@ CouplingMonitor CoupledModel::monitor() const {
   const auto relative = [scale](const Matrix3& r) { return scale > 0 ? frobenius(r) / scale : frobenius(r); };
   CouplingMonitor m;
   m.constraint_residual = relative(residual);
-  m.drift_residual = relative(drift_residual_);
   Matrix3 mismatch = ops_.N * vc - vd;
   if (ops_.tied.size()) mismatch.array() *= ops_.tied.array();  // free components may differ
   const Eigen::Index n = mismatch.rows();
@@ -610,7 +628,8 @@ void CoupledModel::save_state(StateArchive& archive) const {
   archive.put("coupling/mu", rows_of(mu_));
   archive.put("coupling/acceleration_dem", rows_of(acc_d_));
   archive.put("coupling/acceleration_continuum", rows_of(acc_c_));
-  archive.put("coupling/drift_residual", rows_of(drift_residual_));
+  archive.put("coupling/force_dem", rows_of(constraint_force_.dem));
+  archive.put("coupling/force_continuum", rows_of(constraint_force_.continuum));
   archive.put("coupling/work", coupling_work_);
   archive.put("coupling/time", time_);
   archive.put("coupling/steps", std::int64_t{steps_});
@@ -625,13 +644,8 @@ void CoupledModel::load_state(const StateArchive& archive) {
   archive.get_into("coupling/mu", rows_of(mu_));
   archive.get_into("coupling/acceleration_dem", rows_of(acc_d_));
   archive.get_into("coupling/acceleration_continuum", rows_of(acc_c_));
-  // Empty before the first step (a checkpoint at step 0), one row per constraint after.
-  const auto drift = archive.get<Vec3>("coupling/drift_residual");
-  if (!drift.empty() && drift.size() != static_cast<std::size_t>(mu_.rows()))
-    throw StateMismatch("'coupling/drift_residual' holds " + std::to_string(drift.size()) + " rows, this coupling has " +
-                        std::to_string(mu_.rows()) + " constraints");
-  drift_residual_.resize(static_cast<Eigen::Index>(drift.size()), 3);
-  std::copy(drift.begin(), drift.end(), rows_of(drift_residual_).begin());
+  archive.get_into("coupling/force_dem", rows_of(constraint_force_.dem));
+  archive.get_into("coupling/force_continuum", rows_of(constraint_force_.continuum));
   coupling_work_ = archive.number("coupling/work");
   time_ = archive.number("coupling/time");
   steps_ = archive.integer("coupling/steps");
@@ -639,8 +653,5 @@ void CoupledModel::load_state(const StateArchive& archive) {
   breaks_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/breaks_looked_at"));
   held_looked_at_ = static_cast<std::size_t>(archive.integer("coupling/held_looked_at"));
 }
-
-Matrix3 CoupledModel::dem_coupling_force() const { return -(ops_.Gd.transpose() * mu_); }
-Matrix3 CoupledModel::continuum_coupling_force() const { return -(ops_.Gc.transpose() * mu_); }
 
 }  // namespace arlequin::coupling

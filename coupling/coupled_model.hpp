@@ -49,8 +49,8 @@
 //      3. kick_to_trial: both kick dt/2 -> trial velocities v*
 //      4. solve_multipliers: A lambda = G_d v_d* + G_c v_c*
 //      5. correct_velocities: v = v* - M^-1 G^T lambda; mu(n+1) = 2 lambda / dt, and the work
-//         of the multiplier forces over the drift (from the residual of the drift velocities
-//         of step 2)
+//         of the multiplier forces over the drift, G^T (mu(n) + mu(n+1)) dt/2 . v(n+1/2) (the
+//         drift velocities of step 2; MultiplierSolver::project gives G^T lambda)
 //    Steps 3-5 are the constrained velocity-Verlet correction; step 1 is the same constraint force applied
 //    in the first half kick, which keeps v(n+1/2) (the drift velocity) on the constraint.
 //  - options.continuum_substeps = m > 1 (multiple time stepping; "coupling.continuum_substeps"):
@@ -139,7 +139,6 @@ struct CoupledEnergies {
 
 struct CouplingMonitor {
   double constraint_residual = 0.0;    // |G_d v_d + G_c v_c| / |G_d v_d| after the last correction
-  double drift_residual = 0.0;         // the same for the drift velocities v(n+1/2)
   double velocity_mismatch = 0.0;      // rms over coupled DEs of |v_p - (N v_c)(x_p)| (held components), m/s
   double max_velocity_mismatch = 0.0;  // max of the same, m/s
 };
@@ -187,8 +186,8 @@ class CoupledModel {
 
   // Checkpoint (docs/restart.md): both models' states (DemModel::save_state,
   // ContinuumSolver::save_state under "continuum/") and the coupling's own under "coupling/": the
-  // multipliers and constraint accelerations the next step's first half kick applies, the
-  // drift residual, the multiplier work, time, step and the breaks already looked at. load_state
+  // multipliers and constraint accelerations the next step's first half kick applies, their
+  // impulse G^T mu, the multiplier work, time, step and the breaks already looked at. load_state
   // on the coupled model built again from the same case continues bit for bit.
   void save_state(StateArchive& archive) const;
   void load_state(const StateArchive& archive);
@@ -244,9 +243,6 @@ class CoupledModel {
   const MultiplierSolver& multipliers() const { return *solver_; }
   dem::DemModel& dem() { return dem_; }
   continuum::ContinuumSolver& continuum() { return continuum_; }
-  // Multiplier forces of the last step on the coupled DEs / continuum nodes, N (-G^T mu).
-  Matrix3 dem_coupling_force() const;
-  Matrix3 continuum_coupling_force() const;
 
  private:
   void untie_prescribed_rows();
@@ -290,10 +286,11 @@ class CoupledModel {
   std::vector<double> inv_mass_d_, inv_mass_c_;
   Matrix3 acc_d_, acc_c_;  // constraint accelerations M^-1 G^T mu(n) (subtracted)
   Matrix3 mu_;             // multipliers of the constraint force at t(n)
-  Matrix3 drift_residual_;
-  // Scratch of the step (sized once; no allocation per step): coupled DE velocities and
-  // multipliers.
-  Matrix3 vd_, lambda_;
+  MultiplierSolver::Impulse constraint_force_;  // G^T mu(n) on the coupled DEs and the continuum's nodes, N
+  // Scratch of the step (sized once; no allocation per step): coupled DE velocities, those of
+  // the drift and the corrected nodes' (for the multipliers' work), multipliers and their impulse.
+  Matrix3 vd_, vd_drift_, vc_drift_, lambda_;
+  MultiplierSolver::Impulse constraint_force_next_;
   TimeSteps time_steps_;
   bool continuum_stiffness_floored_ = false;
   int prescribed_rows_ = 0;  // rows untied by untie_prescribed_rows

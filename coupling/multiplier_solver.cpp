@@ -215,13 +215,18 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() con
   auto a = std::make_unique<LowRank>();
   a->inv_D.resize(rows);
   a->tied.resize(rows, 3);
-  const Eigen::VectorXd g = ops.Gd.diagonal();
+  a->g = ops.Gd.diagonal();
+  const Eigen::VectorXd& g = a->g;
+  a->inv_g.setZero(rows);
+  a->mass_over_g.setZero(rows);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < 3; ++c) a->tied(r, c) = is_tied(r, c) ? 1.0 : 0.0;
     const double d = g[r] * g[r] * inv_d_(r, 0);  // a DE's inverse mass is the same in x, y and z
     if (a->tied.row(r).any()) {
       if (!(d > 0.0)) return nullptr;  // a driven DE, tied: D is singular
       a->inv_D[r] = 1.0 / d;
+      a->inv_g[r] = 1.0 / g[r];
+      a->mass_over_g[r] = 1.0 / (g[r] * inv_d_(r, 0));
     } else {
       a->inv_D[r] = 1.0;  // no multiplier in any component: the pivot only keeps D invertible
     }
@@ -237,8 +242,20 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() con
           a->node.push_back(it.col());
         }
   a->movable.resize(k, 3);
+  a->mass.resize(k, 3);
   for (int j = 0; j < k; ++j)
-    for (int c = 0; c < 3; ++c) a->movable(j, c) = inv_c_(a->node[static_cast<std::size_t>(j)], c) != 0.0 ? 1.0 : 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double inv = inv_c_(a->node[static_cast<std::size_t>(j)], c);
+      a->movable(j, c) = inv != 0.0 ? 1.0 : 0.0;
+      a->mass(j, c) = inv != 0.0 ? 1.0 / inv : 0.0;
+    }
+  std::vector<Eigen::Triplet<double>> held;
+  for (int r = 0; r < rows; ++r)
+    for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it)
+      if ((inv_c_.row(it.col()).array() == 0.0).any()) held.emplace_back(r, static_cast<int>(it.col()), it.value());
+  a->held.resize(rows, ops.Gc.cols());
+  a->held.setFromTriplets(held.begin(), held.end());
+  a->heldT = RowMajorMatrix(a->held.transpose());
   std::vector<Eigen::Triplet<double>> t;
   for (int r = 0; r < rows; ++r)
     for (SparseMatrix::InnerIterator it(ops.Gc, r); it; ++it)
@@ -269,7 +286,7 @@ std::unique_ptr<MultiplierSolver::LowRank> MultiplierSolver::low_rank_form() con
   Matrix3 r(rows, 3), y;
   for (int i = 0; i < rows; ++i)
     for (int c = 0; c < 3; ++c) r(i, c) = a->tied(i, c) * (1.0 + 0.5 * std::sin(1.0 + i + 7.0 * c));
-  solve_low_rank(*a, r, y, nullptr);
+  solve_low_rank(*a, r, y);
   Matrix3 q = a->Ut * y, Ay(rows, 3);
   for (int j = 0; j < k; ++j)
     for (int c = 0; c < 3; ++c) q(j, c) = a->movable(j, c) != 0.0 ? q(j, c) * inv_c_(a->node[static_cast<std::size_t>(j)], c) : 0.0;
@@ -289,7 +306,7 @@ std::pair<std::array<int, 3>, int> MultiplierSolver::served_by(int k) const {
   return {served, width};
 }
 
-void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const {
+void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda) const {
   const Eigen::Index rows = rhs.rows(), k = a.U.cols();
   y_.resize(rows, 3);
   for_each_index(rows, rows > parallel_threshold, [&](long r) {  // y = D^-1 rhs, 0 in the free components
@@ -304,8 +321,6 @@ void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matr
   for_each_index(rows, rows > parallel_threshold, [&](long r) {  // lambda = y - D^-1 U w
     for (int c = 0; c < 3; ++c) lambda(r, c) = a.tied(r, c) * (y_(r, c) - a.inv_D[r] * lambda(r, c));
   });
-  if (dc)  // M_c^-1 G_c^T lambda = w on U's columns (header)
-    for_each_index(k, k > parallel_threshold, [&](long j) { dc->row(a.node[static_cast<std::size_t>(j)]) = w_.row(j); });
 }
 
 // A depends on the continuum's inverse masses only at the nodes G_c reaches: a node held in one
@@ -401,7 +416,7 @@ MultiplierSolver::MultiplierSolver(const CouplingOperators& ops, const std::vect
 // low-rank form, PETSc's KSP (a column at a time), or our factor of the Jacobi-scaled A,
 // S P^T L D L^T P S lambda = rhs.
 void MultiplierSolver::solve(const Matrix3& rhs, Matrix3& lambda) const {
-  if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda, nullptr);
+  if (low_rank_) return solve_low_rank(*low_rank_, rhs, lambda);
   lambda.resize(rhs.rows(), 3);
   const Eigen::Index rows = rhs.rows();
   if (!petsc_.empty()) {
@@ -561,21 +576,96 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
   if (ops_->tied.size()) out.array() *= ops_->tied.array();
 }
 
-void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const {
-  residual(vd, vc, rhs_);
-  if (dc.rows() != GcT_.rows()) dc.setZero(GcT_.rows(), 3);
-  // The Woodbury solve leaves M_c^-1 G_c^T lambda on U's columns; a corrected node not among them
-  // (held, or reached only by rows left free in the components it moves in) keeps dc's 0.
-  if (low_rank_) {
-    solve_low_rank(*low_rank_, rhs_, lambda, &dc);
-  } else {
-    solve(rhs_, lambda);
-    multiply<3>(GcT_, lambda.data(), 3, dc.data());
-    dc.array() *= inv_c_.array();
+void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc,
+                                        Matrix3& lambda, Impulse* impulse) const {
+  const long rows = ops_->rows(), k = a.U.cols();
+  const bool rows_threaded = rows > parallel_threshold;
+  // h, the held dofs' share of G_c vc (the other components of their nodes are U's).
+  const bool any_held = a.held.nonZeros() > 0;
+  if (any_held) {
+    held_share_.setZero(rows, 3);
+    for_each_index(rows, rows_threaded, [&](long r) {
+      for (RowMajorMatrix::InnerIterator it(a.held, r); it; ++it)
+        for (int c = 0; c < 3; ++c)
+          if (inv_c_(it.col(), c) == 0.0) held_share_(r, c) += it.value() * vc(it.col(), c);
+    });
   }
+  const auto held_share = [&](long r, int c) { return any_held ? held_share_(r, c) : 0.0; };
+  // K v_c' = C^-1 v_c - U^T y on U's columns, y = D^-1 T (W vd + h); 0 where a node is held.
+  y_.resize(rows, 3);
+  for_each_index(rows, rows_threaded, [&](long r) {
+    for (int c = 0; c < 3; ++c) y_(r, c) = a.tied(r, c) * (a.inv_D[r] * (a.g[r] * vd(r, c) + held_share(r, c)));
+  });
+  w_.resize(k, 3);
+  multiply<3>(a.Ut, y_.data(), 3, w_.data());
+  for_each_index(k, k > parallel_threshold, [&](long j) {
+    const int n = a.node[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 3; ++c) w_(j, c) = a.mass(j, c) * vc(n, c) - a.movable(j, c) * w_(j, c);
+  });
+  solve_systems(a.K, w_, w_, nullptr);
+  // The tied components meet their rows, W vd' + U v_c' + h = 0; the others keep their velocity.
+  lambda.resize(rows, 3);
+  dd.resize(rows, 3);
+  const int* outer = a.U.outerIndexPtr();
+  const int* column = a.U.innerIndexPtr();
+  const double* value = a.U.valuePtr();
+  for_each_index(rows, a.U.nonZeros() > parallel_threshold, [&](long r) {
+    double uv[3] = {0.0, 0.0, 0.0};  // row r of U v_c'
+    for (int e = outer[r]; e < outer[r + 1]; ++e)
+      for (int c = 0; c < 3; ++c) uv[c] += value[e] * w_(column[e], c);
+    for (int c = 0; c < 3; ++c) {
+      if (a.tied(r, c) == 0.0) {
+        dd(r, c) = lambda(r, c) = 0.0;
+        continue;
+      }
+      const double projected = -(uv[c] + held_share(r, c)) * a.inv_g[r];
+      dd(r, c) = vd(r, c) - projected;
+      lambda(r, c) = dd(r, c) * a.mass_over_g[r];
+      vd(r, c) = projected;
+    }
+  });
+  for_each_index(k, k > parallel_threshold, [&](long j) {
+    const int n = a.node[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 3; ++c)
+      if (a.movable(j, c) != 0.0) {
+        dc(n, c) = vc(n, c) - w_(j, c);
+        vc(n, c) = w_(j, c);
+      }
+  });
+  if (!impulse) return;
+  impulse->dem.resize(rows, 3);
+  for_each_index(rows, rows_threaded, [&](long r) { impulse->dem.row(r) = a.g[r] * lambda.row(r); });
+  Matrix3& fc = impulse->continuum;
+  if (fc.rows() != GcT_.rows()) fc.setZero(GcT_.rows(), 3);
+  for_each_index(k, k > parallel_threshold, [&](long j) {  // C^-1 dc = G_c^T lambda where the node moves
+    const int n = a.node[static_cast<std::size_t>(j)];
+    for (int c = 0; c < 3; ++c) fc(n, c) = a.mass(j, c) * dc(n, c);
+  });
+  for (int n = 0; n < a.heldT.outerSize(); ++n) {  // and the held components' from their entries
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (RowMajorMatrix::InnerIterator it(a.heldT, n); it; ++it)
+      for (int c = 0; c < 3; ++c) sum[c] += it.value() * lambda(it.col(), c);
+    for (int c = 0; c < 3; ++c)
+      if (inv_c_(n, c) == 0.0) fc(n, c) = sum[c];
+  }
+}
+
+void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda,
+                               Impulse* impulse) const {
+  if (dc.rows() != GcT_.rows()) dc.setZero(GcT_.rows(), 3);
+  if (low_rank_) return project_low_rank(*low_rank_, vd, vc, dd, dc, lambda, impulse);
+  residual(vd, vc, rhs_);
+  solve(rhs_, lambda);
   const long rows = GdT_.rows(), nodes = static_cast<long>(corrected_nodes_.size());
   dd.resize(rows, 3);
+  multiply<3>(GcT_, lambda.data(), 3, dc.data());
   multiply<3>(GdT_, lambda.data(), 3, dd.data());
+  if (impulse) {
+    impulse->dem = dd;
+    if (impulse->continuum.rows() != GcT_.rows()) impulse->continuum.setZero(GcT_.rows(), 3);
+    for (int n : corrected_nodes_) impulse->continuum.row(n) = dc.row(n);
+  }
+  dc.array() *= inv_c_.array();
   for_each_index(rows, rows > parallel_threshold, [&](long r) {
     dd.row(r).array() *= inv_d_.row(r).array();
     vd.row(r) -= dd.row(r);

@@ -41,6 +41,12 @@
 //    against D^-1's scale: the case of a coupling); it is checked at set-up
 //    on a residual of A, matrix-free, and the general LDL^T above is used when the check fails
 //    (or with PETSc, or with H1 coupling, whose S is not diagonal). backend() says which.
+//    project() reads the same form from the velocities, not from the residual: with h the held
+//    dofs' share of G_c v_c and T the ties, the projected continuum velocities on U's columns are
+//    v_c' = v_c - w = K^-1 (C^-1 v_c - U^T D^-1 T (W v_d + h)), the tied DE components meet
+//    their constraint, v_d' = -(U v_c' + h) / W, and lambda = (v_d - v_d') / (W M_d^-1): the
+//    mass-weighted mean of the two models' motion, in two passes over U (the residual's pass
+//    over G_c is not needed), whose constraint holds to the round-off of one product.
 //  - Backend: our sparse LDL^T above, or PETSc's KSP when `petsc` is set (PetscSpdSolver, on
 //    the same Jacobi-scaled A, with the case's options: PETSc's way of choosing a solver at run
 //    time, e.g. an iterative one for a large overlap; the application's default, preonly +
@@ -80,8 +86,14 @@ class MultiplierSolver {
   // to 0 when it is resized and is not 0 only on corrected_nodes(): the general solve writes every
   // row, the Woodbury form only U's columns (0 in a component a node is held in). A
   // caller that keeps dc between calls (and changes it only on corrected_nodes()) reads the
-  // whole correction in it.
-  void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda) const;
+  // whole correction in it. With `impulse`, also the multipliers' impulses G_d^T lambda (DEs x 3)
+  // and G_c^T lambda (nodes x 3, set to 0 when resized and written on corrected_nodes() only),
+  // held DEs and dofs included: what the work of the multiplier forces needs.
+  struct Impulse {
+    Matrix3 dem, continuum;
+  };
+  void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda,
+               Impulse* impulse = nullptr) const;
   // The continuum nodes a projection can correct (those G_c reaches), in increasing order.
   const std::vector<int>& corrected_nodes() const { return corrected_nodes_; }
 
@@ -116,11 +128,19 @@ class MultiplierSolver {
   // The Woodbury form of one component's A (above).
   using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct LowRank {
+    Eigen::VectorXd g;                // G_d's diagonal
+    Eigen::VectorXd inv_g;            // 1 / g, and m_d / g (lambda per DE velocity correction); 0 where a row is free
+    Eigen::VectorXd mass_over_g;
     Eigen::VectorXd inv_D;            // per row
     Matrix3 tied;                     // per row and component: 1 held, 0 free (CouplingOperators::tied)
     RowMajorMatrix U, Ut;             // rows x the nodes G_c reaches that can move (all components'), its transpose
     std::vector<int> node;            // the continuum node of each of U's columns
     Matrix3 movable;                  // per column and component: 1 where the node can move, 0 where held
+    Matrix3 mass;                     // per column and component: the continuum mass (1 / inverse mass), 0 where held
+    // G_c's entries at nodes held in some component (the other components' products mask
+    // them), rows x nodes, and its transpose: the held dofs' share of the residual and of
+    // G_c^T lambda. Empty where no row reaches a held dof.
+    RowMajorMatrix held, heldT;
     std::vector<ForestFactor> K;      // per system, over all of U's columns
   };
   // The low-rank form of A, or nullptr when it does not apply or its set-up residual check fails.
@@ -128,8 +148,11 @@ class MultiplierSolver {
   // Whether the constraint holds row r's component c (CouplingOperators::tied).
   bool is_tied(int r, int c) const { return ops_->tied.size() == 0 || ops_->tied(r, c) != 0.0; }
   // lambda = A^-1 rhs, every system at once: the products with U and U^T read U once for the
-  // three components; with `dc`, dc = M_c^-1 G_c^T lambda on U's columns (the rest untouched).
-  void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda, Matrix3* dc) const;
+  // three components.
+  void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda) const;
+  // project() in the low-rank form, from the velocities (the header's direct form).
+  void project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc,
+                        Matrix3& lambda, Impulse* impulse) const;
   // out = A_s^-1 in in the components each system s serves, A_s = factors[s], every system at
   // once (the tasks of all of them on the threads); with `scales`, A_s is the scaled S A S and
   // in and out are scaled by S (scales[s] per row). out may be in.
@@ -157,6 +180,7 @@ class MultiplierSolver {
   mutable std::vector<double> solution_;       // scratch: a component (PETSc)
   mutable std::vector<std::vector<double>> blocks_, block_scratch_;  // scratch: each system's components
   mutable Matrix3 y_, w_;                      // scratch: the low-rank form's D^-1 rhs and K^-1 U^T y
+  mutable Matrix3 held_share_;                 // scratch: the held dofs' share of G_c vc, per row
 };
 
 }  // namespace arlequin::coupling

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdio>
 
 #include "common/error.hpp"
 #include "common/parallel.hpp"
@@ -183,6 +184,30 @@ TEST(CouplingMultiplierSolver, FineMediatorIsSolvedByTheWoodburyFormAsByTheFacto
   woodbury.residual(w.vd, w.vc, residual);
   EXPECT_LT(residual.norm(), 1e-12 * 1e-9 * vd.norm());  // G v = 0, G's scale being w ~ 1e-9
   EXPECT_EQ(w.vc(2, 1), vc(2, 1));                      // the held dof
+}
+
+// The impulses a projection returns are G_d^T lambda and G_c^T lambda, a held dof's reaction
+// included (node 2 along y): the Woodbury form reads them from the corrections (C^-1 dc where a
+// node moves), the general factor from its products; both against the products of the operators.
+TEST(CouplingMultiplierSolver, TheImpulsesAreGTransposedLambdaWithTheHeldDofs) {
+  const auto [fine, md, mc] = shared_nodes();
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;
+  const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
+  for (const MultiplierSolver* solver : {&woodbury, &factor}) {
+    Matrix3 vd, vc, dd, dc, lambda;
+    mixed_velocities(fine.num_particles(), fine.Gc.cols(), 0.03, 0.1, vd, vc);
+    MultiplierSolver::Impulse impulse;
+    solver->project(vd, vc, dd, dc, lambda, &impulse);
+    const Matrix3 dem = fine.Gd.transpose() * lambda, continuum = fine.Gc.transpose() * lambda;
+    std::printf("[impulse %s] relative error DEs %.1e, nodes %.1e\n", solver->backend().substr(0, 5).c_str(),
+                (impulse.dem - dem).norm() / dem.norm(), (impulse.continuum - continuum).norm() / continuum.norm());
+    // Measured: 0 for the factor, 3e-15 of the nodes' for the Woodbury form (C^-1 dc): 30 times below.
+    EXPECT_LT((impulse.dem - dem).norm(), 1e-13 * dem.norm()) << solver->backend();
+    EXPECT_LT((impulse.continuum - continuum).norm(), 1e-13 * continuum.norm()) << solver->backend();
+    EXPECT_GT(std::abs(continuum(2, 1)), 1e-3 * continuum.norm());  // the held dof's reaction is there to check
+    EXPECT_NEAR(impulse.continuum(2, 1), continuum(2, 1), 1e-13 * continuum.norm()) << solver->backend();
+  }
 }
 
 // Two bodies coupled apart (the DCB's two arms): K falls into two blocks, its factor's
