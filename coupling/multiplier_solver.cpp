@@ -641,6 +641,7 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
     const int n = a.node[static_cast<std::size_t>(j)];
     for (int c = 0; c < 3; ++c) fc(n, c) = a.mass(j, c) * dc(n, c);
   });
+  if (!any_held) return;
   for (int n = 0; n < a.heldT.outerSize(); ++n) {  // and the held components' from their entries
     double sum[3] = {0.0, 0.0, 0.0};
     for (RowMajorMatrix::InnerIterator it(a.heldT, n); it; ++it)
