@@ -87,12 +87,12 @@ void carry_rows(const StateArchive& from, StateArchive& to, const std::string& n
 
 void carry_entry(const StateArchive& from, StateArchive& to, const std::string& name) { to.put_entry(name, from.entries().at(name)); }
 
-// Row r of `archive`'s entry `name` to zero where map[r] == -2.
-void zero_rows(StateArchive& archive, const std::string& name, const std::vector<long>& map) {
+// Row r of `archive`'s entry `name` to zero where zero[r].
+void zero_rows(StateArchive& archive, const std::string& name, const std::vector<char>& zero) {
   StateArchive::Entry entry = archive.entries().at(name);
   const std::size_t row = entry.width * element_size(entry.kind);
-  for (std::size_t r = 0; r < map.size(); ++r)
-    if (map[r] == -2) std::memset(entry.bytes.data() + r * row, 0, row);
+  for (std::size_t r = 0; r < zero.size(); ++r)
+    if (zero[r]) std::memset(entry.bytes.data() + r * row, 0, row);
   archive.put_entry(name, std::move(entry));
 }
 
@@ -473,8 +473,8 @@ std::unique_ptr<Scene> move_zone(const Scene& first, Scene& current, BandPlace p
   if (const int steps = follow_of(*next).relax_steps; start_moved && steps > 0) {
     StateArchive target;
     next->model->save_accelerations(target);
-    std::vector<long> kept(pn.size());
-    for (std::size_t i = 0; i < pn.size(); ++i) kept[i] = old_of_new[i] >= 0 ? -2 : -1;
+    std::vector<char> kept(pn.size());  // the DEs both scenes have
+    for (std::size_t i = 0; i < pn.size(); ++i) kept[i] = old_of_new[i] >= 0;
     zero_rows(target, "accelerations/dem/translation", kept);
     zero_rows(target, "accelerations/dem/rotation", kept);
     target.put("accelerations/continuum", std::vector<double>(target.get<double>("accelerations/continuum").size(), 0.0));

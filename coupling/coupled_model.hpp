@@ -187,7 +187,7 @@ class CoupledModel {
   // Checkpoint (docs/restart.md): both models' states (DemModel::save_state,
   // ContinuumSolver::save_state under "continuum/") and the coupling's own under "coupling/": the
   // multipliers and constraint accelerations the next step's first half kick applies, their
-  // impulse G^T mu, the multiplier work, time, step and the breaks already looked at. load_state
+  // forces G^T mu, the multiplier work, time, step and the breaks already looked at. load_state
   // on the coupled model built again from the same case continues bit for bit.
   void save_state(StateArchive& archive) const;
   void load_state(const StateArchive& archive);

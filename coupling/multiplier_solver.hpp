@@ -129,8 +129,8 @@ class MultiplierSolver {
   using RowMajorMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct LowRank {
     Eigen::VectorXd g;                // G_d's diagonal
-    Eigen::VectorXd inv_g;            // 1 / g, and m_d / g (lambda per DE velocity correction); 0 where a row is free
-    Eigen::VectorXd mass_over_g;
+    Eigen::VectorXd inv_g;            // 1 / g per row, 0 where a row is free in every component
+    Eigen::VectorXd mass_over_g;      // m_d / g: a row's multiplier per unit of its DE's correction; 0 likewise
     Eigen::VectorXd inv_D;            // per row
     Matrix3 tied;                     // per row and component: 1 held, 0 free (CouplingOperators::tied)
     RowMajorMatrix U, Ut;             // rows x the nodes G_c reaches that can move (all components'), its transpose
