@@ -43,13 +43,19 @@ for t in "${targets[@]}"; do
   rm -rf "$crashes"
   mkdir -p "$corpus" "$crashes"
   log="$root/build-fuzz/$t.log"
+  # The targets' scratch files (fuzz/fuzz_input.hpp) and MPI's go to a folder of the run's own,
+  # removed after it: a folder per process under /tmp would pile up from run to run.
+  scratch="$root/build-fuzz/tmp/$t"
+  rm -rf "$scratch"
+  mkdir -p "$scratch"
   # -timeout: an input that takes longer is a defect too (a reader that hangs); -rss_limit_mb:
   # the readers refuse what needs more than the fuzz budget (fuzz/fuzz_input.hpp) long before.
   set +e
-  (cd "$root/build-fuzz" && "$fuzz_dir/$t" "$corpus" "$seed_dir/$t" -max_total_time="$per_target" -timeout=30 \
+  (cd "$root/build-fuzz" && TMPDIR="$scratch" "$fuzz_dir/$t" "$corpus" "$seed_dir/$t" -max_total_time="$per_target" -timeout=30 \
       -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$crashes/" >"$log" 2>&1)
   code=$?
   set -e
+  rm -rf "$scratch"
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*' || echo 0)
   # crash-, timeout- and oom- files are failures; slow-unit- files (over 10 s, under the
