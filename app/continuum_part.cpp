@@ -532,6 +532,7 @@ class Part final : public ContinuumPart {
   }
   bool prescribed(std::size_t dof) const override { return solver_->is_fixed(static_cast<int>(dof)); }
   void internal_force(const std::vector<double>& u, std::vector<double>& f) const override { solver_->internal_force(u, f); }
+  std::vector<double> stiffness_diagonal() const override { return solver_->stiffness_diagonal(); }
   ShapeValues shape_values(const std::vector<Vec3>& points) const override {
     ShapeValues rows(points.size());
     const auto take = [&rows](const continuum::InterpolationOperator& N, std::size_t first) {

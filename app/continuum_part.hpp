@@ -91,6 +91,8 @@ class ContinuumPart {
   virtual ShapeValues shape_values(const std::vector<Vec3>& points) const = 0;
   // f_int(u) (3 values a node) of the continuum as weighted: K u for small strains.
   virtual void internal_force(const std::vector<double>& u, std::vector<double>& f) const = 0;
+  // Per dof, the diagonal of the continuum's stiffness at the undeformed state, as weighted (N/m).
+  virtual std::vector<double> stiffness_diagonal() const = 0;
   // The model that steps `dem` (built, with its boundary conditions, not finalized) and this
   // continuum together, coupled as the coupling section given to `read` says; it finalizes
   // the DEM. Its errors name their key in that section. std::invalid_argument for

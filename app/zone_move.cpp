@@ -202,9 +202,11 @@ std::pair<Vec3, Vec3> motion_from_des(const dem::ParticleSet& p, const Vec3& X, 
 
 // The displacement of the nodes `refit` in equilibrium with the others held (and the dofs a
 // support or driven strip sets): the least strain energy of the continuum as the new scene
-// weighs it. One Newton step from u (its linear system by conjugate gradients on those nodes'
-// dofs, K times a direction by central differences of f_int); the step's residual 1e-8 of the
-// start's. Directions no weighted element stiffens stay as they were.
+// weighs it. One Newton step from u: its linear system by conjugate gradients on those nodes'
+// dofs, K times a direction by central differences of f_int, preconditioned by the diagonal of
+// the stiffness at the undeformed state (Jacobi: the dofs' stiffnesses span the weights and the
+// elements' shapes, a P2 vertex's and a mid-edge node's differ); stopped when the residual is
+// 1e-8 of the start's. Dofs no weighted element stiffens stay as they were.
 void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit, std::vector<double>& u) {
   std::vector<std::size_t> dofs;
   for (std::size_t a = 0; a < refit.size(); ++a)
@@ -218,6 +220,11 @@ void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit,
     for (std::size_t k = 0; k < n; ++k) sum += a[k] * b[k];
     return sum;
   };
+  std::vector<double> inverse_diagonal(n);
+  {
+    const std::vector<double> diagonal = continuum.stiffness_diagonal();
+    for (std::size_t k = 0; k < n; ++k) inverse_diagonal[k] = diagonal[dofs[k]] > 0.0 ? 1.0 / diagonal[dofs[k]] : 0.0;
+  }
   std::vector<double> f(u.size()), plus(u.size()), minus(u.size()), shifted(u.size());
   // K p on the dofs, by central differences of f_int over 1e-7 m along p's largest component.
   const auto stiffness_times = [&](const std::vector<double>& p, std::vector<double>& out) {
@@ -232,20 +239,20 @@ void relax_nodes(const ContinuumPart& continuum, const std::vector<char>& refit,
     for (std::size_t k = 0; k < n; ++k) out[k] = (plus[dofs[k]] - minus[dofs[k]]) / (2.0 * h);
   };
   continuum.internal_force(u, f);
-  std::vector<double> x(n, 0.0), r(n), p(n), Ap(n);
-  for (std::size_t k = 0; k < n; ++k) r[k] = -f[dofs[k]];
-  p = r;
-  double rr = dot(r, r);
-  const double stop = 1e-16 * rr;
-  for (std::size_t it = 0; it < 2 * n && rr > stop; ++it) {
+  std::vector<double> x(n, 0.0), r(n), z(n), p(n), Ap(n);
+  for (std::size_t k = 0; k < n; ++k) r[k] = -f[dofs[k]], z[k] = inverse_diagonal[k] * r[k];
+  p = z;
+  double rz = dot(r, z);
+  const double stop = 1e-16 * dot(r, r);
+  for (std::size_t it = 0; it < 2 * n && dot(r, r) > stop; ++it) {
     stiffness_times(p, Ap);
     const double pAp = dot(p, Ap);
     if (!(pAp > 0.0)) break;  // a direction nothing stiffens
-    const double alpha = rr / pAp;
-    for (std::size_t k = 0; k < n; ++k) x[k] += alpha * p[k], r[k] -= alpha * Ap[k];
-    const double rr_next = dot(r, r);
-    for (std::size_t k = 0; k < n; ++k) p[k] = r[k] + (rr_next / rr) * p[k];
-    rr = rr_next;
+    const double alpha = rz / pAp;
+    for (std::size_t k = 0; k < n; ++k) x[k] += alpha * p[k], r[k] -= alpha * Ap[k], z[k] = inverse_diagonal[k] * r[k];
+    const double rz_next = dot(r, z);
+    for (std::size_t k = 0; k < n; ++k) p[k] = z[k] + (rz_next / rz) * p[k];
+    rz = rz_next;
   }
   for (std::size_t k = 0; k < n; ++k) u[dofs[k]] += x[k];
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "common/parallel.hpp"
 
@@ -19,6 +20,10 @@ BlockMatrix3::BlockMatrix3(const std::vector<std::vector<int>>& columns) {
 }
 
 BlockMatrix3::Block& BlockMatrix3::block(int row, int column) {
+  return const_cast<Block&>(std::as_const(*this).block(row, column));
+}
+
+const BlockMatrix3::Block& BlockMatrix3::block(int row, int column) const {
   const auto first = column_.begin() + offset_[row], last = column_.begin() + offset_[row + 1];
   const auto it = std::lower_bound(first, last, column);
   if (it == last || *it != column)

@@ -29,6 +29,7 @@ class BlockMatrix3 {
   int rows() const { return static_cast<int>(offset_.size()) - 1; }
   std::size_t blocks() const { return column_.size(); }
   Block& block(int row, int column);  // must be in the pattern
+  const Block& block(int row, int column) const;
   // Adds the 3x3 block at (3 a, 3 b) of the row-major (3 m) x (3 m) matrix `dense` to block
   // (nodes[a], nodes[b]) for every a, b < m.
   void add(const std::vector<int>& nodes, const double* dense);

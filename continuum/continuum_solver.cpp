@@ -271,6 +271,14 @@ const BlockMatrix3& ContinuumSolver::stiffness() const {
   return stiffness_;
 }
 
+std::vector<double> ContinuumSolver::stiffness_diagonal() const {
+  const BlockMatrix3& K = stiffness();
+  std::vector<double> diagonal(3 * static_cast<size_t>(num_nodes()));
+  for (int n = 0; n < num_nodes(); ++n)
+    for (int c = 0; c < 3; ++c) diagonal[3 * static_cast<size_t>(n) + c] = K.block(n, n)[static_cast<size_t>(4 * c)];
+  return diagonal;
+}
+
 void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> components, VectorFunction g) {
   for (int n : mesh_.group(group).nodes)
     for (int c = 0; c < 3; ++c) {

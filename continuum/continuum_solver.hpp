@@ -172,6 +172,9 @@ class ContinuumSolver {
   // cases, but a state with a rigid motion 1e6 times its strains would see it. Finite: the
   // point sum of the contract.
   double strain_energy() const;
+  // Per dof, K's diagonal (K the tangent at the undeformed state, as weighted), N/m: the scale
+  // of each dof's stiffness, for preconditioning a solve with the tangent of either kinematics.
+  std::vector<double> stiffness_diagonal() const;
   // 1/2 v.M v; with `kick` (s): that of the velocities a kick by it with the present forces
   // would give, the state unchanged (a multiple-time-step caller's synchronised velocities).
   double kinetic_energy(double kick = 0.0) const;
