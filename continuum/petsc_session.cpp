@@ -52,6 +52,9 @@ PetscSession::PetscSession(const std::string& options) {
     remove_mpi_session_base();
     petsc_check(code, "PetscInitialize");
   }
+  // MPI has read it: the environment goes back to what it was, so that a program this one starts
+  // (a test running a case) makes a base of its own instead of sharing this one.
+  if (!g_mpi_session_base.empty()) unsetenv("OMPI_MCA_orte_tmpdir_base");
   if (!options.empty()) petsc_check(PetscOptionsInsertString(nullptr, options.c_str()), "PETSc options");
   g_started = true;
 }
