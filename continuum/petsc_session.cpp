@@ -14,7 +14,8 @@ namespace arlequin::continuum {
 namespace {
 bool g_started = false;
 
-// Open MPI's session directory for this process (empty if the user chose one), removed at exit.
+// Open MPI's session base made for this process (empty where one was set already or none could
+// be made), removed at exit.
 std::string g_mpi_session_base;
 
 // Open MPI 4 starts a singleton in <base>/ompi.<host>.<uid>, a directory every process on the
@@ -48,13 +49,14 @@ PetscSession::PetscSession(const std::string& options) {
   give_mpi_a_session_base_of_its_own();
   // No argc/argv: options reach PETSc through the string only, so the application decides
   // which command-line words are PETSc's.
-  if (const PetscErrorCode code = PetscInitialize(nullptr, nullptr, nullptr, nullptr); code != 0) {
-    remove_mpi_session_base();
-    petsc_check(code, "PetscInitialize");
-  }
+  const PetscErrorCode code = PetscInitialize(nullptr, nullptr, nullptr, nullptr);
   // MPI has read it: the environment goes back to what it was, so that a program this one starts
   // (a test running a case) makes a base of its own instead of sharing this one.
   if (!g_mpi_session_base.empty()) unsetenv("OMPI_MCA_orte_tmpdir_base");
+  if (code != 0) {
+    remove_mpi_session_base();
+    petsc_check(code, "PetscInitialize");
+  }
   if (!options.empty()) petsc_check(PetscOptionsInsertString(nullptr, options.c_str()), "PETSc options");
   g_started = true;
 }
