@@ -259,6 +259,56 @@ TEST(CohesiveBlocks, ALinkInABlockActsAsTheLinkAlone) {
   EXPECT_EQ(pushed, 3);
 }
 
+// The force pass passes over a block whose eight links have all failed (a delamination's wake):
+// 24 links between their own DEs, one colour, in three blocks: pre-cracked; opened past failure
+// (d = 1 after the first pass, failed only once find_failures has seen them); below the onset.
+// After a plain pass and a scanning pass, the failed block's DEs have no force, its links keep
+// their damage and dissipate nothing, and the second block, at d = 1 but not yet failed, is still
+// evaluated: its eight failures are reported (a skip that went by the damage, not by the failed
+// flag, would report none); every DE's actions are those of its link evaluated alone.
+TEST(CohesiveBlocks, AWholeBlockOfFailedLinksIsPassedOver) {
+  constexpr int links = 24;
+  CohesiveContactSet::Parameters q{sigma_n, sigma_s, G_I, G_II, k, 2.0, Region(Box{{0.5, -1, -1}, {1.5, 75, 1}}), 0.0};
+  const auto build = [&](ParticleSet& p) {
+    auto set = std::make_unique<CohesiveContactSet>(q);  // the links at y = 0 .. 70 m start failed
+    for (int m = 0; m < links; ++m) {
+      p.add({0, 10.0 * m, 0}, 1.0, 1.0);
+      p.add({2, 10.0 * m, 0}, 1.0, 1.0);
+      set->add(2 * m, 2 * m + 1, p);
+    }
+    set->finalize(p.size());
+    for (int m = 0; m < links; ++m) p.position[2 * m + 1] += Vec3{m < 16 ? 2 * dnf : 0.5 * dn0, 0, 0};
+    return set;
+  };
+  ParticleSet blocks, alone;
+  const auto set = build(blocks), single = build(alone);
+  ASSERT_EQ(set->colours(), 1u);
+  for (int m = 0; m < links; ++m) ASSERT_EQ(set->first()[m], std::uint32_t(2 * m));  // blocks of eight in this order
+  blocks.clear_forces();
+  set->accumulate_forces(blocks, ForceScan{});
+  blocks.clear_forces();
+  set->accumulate_forces(blocks, criterion_scan());
+  std::vector<BreakEvent> events;
+  set->find_failures(blocks, 0, 0.0, events);
+  ASSERT_EQ(events.size(), 8u);
+  for (int n = 0; n < 8; ++n) EXPECT_EQ(events[n].bond, std::uint32_t(8 + n));
+  for (int m = 0; m < links; ++m) {
+    const auto e = single->evaluate(m, alone);  // its stored damage is 0 but for the pre-cracked
+    EXPECT_EQ(blocks.force[2 * m + 1], e.force_on_j) << m;
+    EXPECT_EQ(blocks.torque[2 * m], e.torque_on_i) << m;
+    if (m < 8) {
+      EXPECT_EQ(blocks.force[2 * m + 1], Vec3{}) << m;
+      EXPECT_EQ(set->damage_values()[m], 1.0) << m;
+      EXPECT_EQ(set->dissipated_values()[m], 0.0) << m;
+    } else if (m < 16) {
+      EXPECT_EQ(set->damage_values()[m], 1.0) << m;
+      EXPECT_NEAR(set->dissipated_values()[m], G_I * S, 1e-9 * G_I * S) << m;  // in the first pass, once
+    } else {
+      EXPECT_EQ(set->damage_values()[m], 0.0) << m;
+    }
+  }
+}
+
 TEST(CohesiveParameters, AreRefusedWhenTheSofteningOpeningIsNotBeyondTheElasticOne) {
   CohesiveContactSet::Parameters q{sigma_n, sigma_s, G_I, G_II, k, 2.0, std::nullopt, 0.0};
   EXPECT_NO_THROW(CohesiveContactSet{q});
