@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "continuum/petsc_session.hpp"
+#include "support/cli.hpp"
 
 namespace fs = std::filesystem;
 using arlequin::continuum::PetscSession;
@@ -42,9 +43,7 @@ std::vector<std::pair<std::string, bool>> session_bases(const fs::path& dir) {
 TEST(ContinuumPetscSession, MpiKeepsItsFilesInADirectoryOfItsOwn) {
   if (g_base_given) GTEST_SKIP() << "OMPI_MCA_orte_tmpdir_base is set in the environment";
   ASSERT_FALSE(PetscSession::started());  // MPI is started in the child only
-  const fs::path tmp = fs::temp_directory_path() / ("arlequin_petsc_session_" + std::to_string(getpid()));
-  fs::remove_all(tmp);
-  fs::create_directories(tmp);
+  const fs::path tmp = arlequin::test::scratch_dir("petsc_session_" + std::to_string(getpid()));
   const pid_t child = fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
