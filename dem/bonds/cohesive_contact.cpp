@@ -257,7 +257,8 @@ void CohesiveContactSet::accumulate_forces(ParticleSet& p, const ForceScan& scan
   const std::uint8_t* broken = broken_.data();
   for_each_bond_block(colouring_, static_cast<long>(simd::lanes), [&](std::size_t first, std::size_t end) {
     // A block of failed links is skipped: each would carry no force, keep its damage (1) and
-    // dissipate nothing more, and find_failures passes it by.
+    // dissipate nothing more, and its scan records need no update (break_bond set its energy to 0,
+    // find_failures passes failed links by, the virial leaves them out).
     if (std::all_of(broken + first, broken + end, [](std::uint8_t failed) { return failed != 0; })) return;
     Evaluation e[simd::lanes];
     evaluate_block(first, end - first, p, e);
