@@ -14,6 +14,13 @@ namespace arlequin {
 // Loops of at most this many items run on one thread: below it, starting threads costs more
 // than it saves.
 inline constexpr long parallel_threshold = 4096;
+// The same for the coupling's loops over its rows (a coupled DE's or a corrected node's three
+// components, gathered from and scattered to the models' arrays through an index list, or a row
+// of a sparse product): a row costs several times a plain per-DE update, so a loop of a thousand
+// rows already takes several times what entering a parallel region costs (bench_omp_regions). The
+// coupled fabric's 2 502 coupled DEs and the coupled DCB's ~3 000 ran on one thread below
+// parallel_threshold (docs/performance.md#coupling-rows).
+inline constexpr long parallel_threshold_rows = 1024;
 // The same for bonds, per colour of a bond set on average (dem::BondColouring). A bond costs
 // 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
 // hundred to a few thousand bonds, which parallel_threshold would keep on one thread; 256 puts

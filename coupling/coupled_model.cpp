@@ -427,7 +427,7 @@ std::string CoupledModel::summary() const {
 void CoupledModel::gather_dem_velocity(Matrix3& v) const {
   const long np = ops_.num_particles();
   v.resize(np, 3);
-  for_each_index(np, np > parallel_threshold, [&](long p) {
+  for_each_index(np, np > parallel_threshold_rows, [&](long p) {
     const Vec3& u = dem_.particles.velocity[ops_.particles[p]];
     v.row(p) << u.x, u.y, u.z;
   });
@@ -435,7 +435,7 @@ void CoupledModel::gather_dem_velocity(Matrix3& v) const {
 
 void CoupledModel::scatter_dem_velocity(const Matrix3& v) {
   const long np = ops_.num_particles();
-  for_each_index(np, np > parallel_threshold,
+  for_each_index(np, np > parallel_threshold_rows,
                  [&](long p) { dem_.particles.velocity[ops_.particles[p]] = {v(p, 0), v(p, 1), v(p, 2)}; });
 }
 
@@ -457,13 +457,13 @@ void CoupledModel::step(double dt) {
 void CoupledModel::constraint_half_kick(double dt) {
   const double h = 0.5 * dt;
   const long np = ops_.num_particles();
-  for_each_index(np, np > parallel_threshold, [&](long p) {
+  for_each_index(np, np > parallel_threshold_rows, [&](long p) {
     dem_.particles.velocity[ops_.particles[p]] -= Vec3{acc_d_(p, 0), acc_d_(p, 1), acc_d_(p, 2)} * h;
   });
   // acc_c_ is 0 but on the nodes the projection corrects
   const std::vector<int>& nodes = solver_->corrected_nodes();
   Eigen::Map<Matrix3> vc = continuum_velocity();
-  for_each_index(static_cast<long>(nodes.size()), static_cast<long>(nodes.size()) > parallel_threshold, [&](long k) {
+  for_each_index(static_cast<long>(nodes.size()), static_cast<long>(nodes.size()) > parallel_threshold_rows, [&](long k) {
     const int n = nodes[static_cast<std::size_t>(k)];
     vc.row(n) -= h * acc_c_.row(n);
   });
@@ -481,7 +481,7 @@ void CoupledModel::advance_models(double dt) {
   const std::vector<int>& nodes = solver_->corrected_nodes();
   const Eigen::Map<Matrix3> vc = continuum_velocity();
   vc_drift_.resize(static_cast<Eigen::Index>(nodes.size()), 3);
-  for_each_index(vc_drift_.rows(), vc_drift_.rows() > parallel_threshold,
+  for_each_index(vc_drift_.rows(), vc_drift_.rows() > parallel_threshold_rows,
                  [&](long k) { vc_drift_.row(k) = vc.row(nodes[static_cast<std::size_t>(k)]); });
 }
 

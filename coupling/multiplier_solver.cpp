@@ -51,7 +51,7 @@ void load_permuted(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f, 
   const int* perm = f.permutationP().indices().data();
   scratch.resize(static_cast<std::size_t>(n) * sizeof(Row) / sizeof(double));
   Row* y = reinterpret_cast<Row*>(scratch.data());
-  for_each_index(n, n > parallel_threshold, [&](long i) {
+  for_each_index(n, n > parallel_threshold_rows, [&](long i) {
     Row row{};
     for (int c = 0; c < width; ++c) row[c] = x[i * width + c];
     y[perm[i]] = row;
@@ -170,7 +170,7 @@ void store_permuted(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f,
   const Eigen::Index n = f.matrixL().nestedExpression().cols();
   const int* perm = f.permutationP().indices().data();
   const Row* y = reinterpret_cast<const Row*>(scratch.data());
-  for_each_index(n, n > parallel_threshold, [&](long i) {
+  for_each_index(n, n > parallel_threshold_rows, [&](long i) {
     for (int c = 0; c < width; ++c) x[i * width + c] = y[perm[i]][c];
   });
 }
@@ -309,7 +309,7 @@ std::pair<std::array<int, 3>, int> MultiplierSolver::served_by(int k) const {
 void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda) const {
   const Eigen::Index rows = rhs.rows(), k = a.U.cols();
   y_.resize(rows, 3);
-  for_each_index(rows, rows > parallel_threshold, [&](long r) {  // y = D^-1 rhs, 0 in the free components
+  for_each_index(rows, rows > parallel_threshold_rows, [&](long r) {  // y = D^-1 rhs, 0 in the free components
     for (int c = 0; c < 3; ++c) y_(r, c) = a.tied(r, c) * (a.inv_D[r] * rhs(r, c));
   });
   w_.resize(k, 3);
@@ -318,7 +318,7 @@ void MultiplierSolver::solve_low_rank(const LowRank& a, const Matrix3& rhs, Matr
   solve_systems(a.K, w_, w_, nullptr);
   lambda.resize(rows, 3);
   multiply<3>(a.U, w_.data(), 3, lambda.data());  // U w
-  for_each_index(rows, rows > parallel_threshold, [&](long r) {  // lambda = y - D^-1 U w
+  for_each_index(rows, rows > parallel_threshold_rows, [&](long r) {  // lambda = y - D^-1 U w
     for (int c = 0; c < 3; ++c) lambda(r, c) = a.tied(r, c) * (y_(r, c) - a.inv_D[r] * lambda(r, c));
   });
 }
@@ -579,7 +579,7 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc,
                                         Matrix3& lambda, Impulse* impulse) const {
   const long rows = ops_->rows(), k = a.U.cols();
-  const bool rows_threaded = rows > parallel_threshold;
+  const bool rows_threaded = rows > parallel_threshold_rows;
   // h, the held dofs' share of G_c vc (the other components of their nodes are U's).
   const bool any_held = a.held.nonZeros() > 0;
   if (any_held) {
@@ -598,7 +598,7 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
   });
   w_.resize(k, 3);
   multiply<3>(a.Ut, y_.data(), 3, w_.data());
-  for_each_index(k, k > parallel_threshold, [&](long j) {
+  for_each_index(k, k > parallel_threshold_rows, [&](long j) {
     const int n = a.node[static_cast<std::size_t>(j)];
     for (int c = 0; c < 3; ++c) w_(j, c) = a.mass(j, c) * vc(n, c) - a.movable(j, c) * w_(j, c);
   });
@@ -624,7 +624,7 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
       vd(r, c) = projected;
     }
   });
-  for_each_index(k, k > parallel_threshold, [&](long j) {
+  for_each_index(k, k > parallel_threshold_rows, [&](long j) {
     const int n = a.node[static_cast<std::size_t>(j)];
     for (int c = 0; c < 3; ++c)
       if (a.movable(j, c) != 0.0) {
@@ -637,7 +637,7 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
   for_each_index(rows, rows_threaded, [&](long r) { impulse->dem.row(r) = a.g[r] * lambda.row(r); });
   Matrix3& fc = impulse->continuum;
   if (fc.rows() != GcT_.rows()) fc.setZero(GcT_.rows(), 3);
-  for_each_index(k, k > parallel_threshold, [&](long j) {  // C^-1 dc = G_c^T lambda where the node moves
+  for_each_index(k, k > parallel_threshold_rows, [&](long j) {  // C^-1 dc = G_c^T lambda where the node moves
     const int n = a.node[static_cast<std::size_t>(j)];
     for (int c = 0; c < 3; ++c) fc(n, c) = a.mass(j, c) * dc(n, c);
   });
@@ -667,11 +667,11 @@ void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd,
     for (int n : corrected_nodes_) impulse->continuum.row(n) = dc.row(n);
   }
   dc.array() *= inv_c_.array();
-  for_each_index(rows, rows > parallel_threshold, [&](long r) {
+  for_each_index(rows, rows > parallel_threshold_rows, [&](long r) {
     dd.row(r).array() *= inv_d_.row(r).array();
     vd.row(r) -= dd.row(r);
   });
-  for_each_index(nodes, nodes > parallel_threshold, [&](long k) {
+  for_each_index(nodes, nodes > parallel_threshold_rows, [&](long k) {
     const int n = corrected_nodes_[static_cast<std::size_t>(k)];
     vc.row(n) -= dc.row(n);
   });
