@@ -15,11 +15,11 @@ namespace arlequin {
 // than it saves.
 inline constexpr long parallel_threshold = 4096;
 // The same for the coupling's loops over its rows (a coupled DE's or a corrected node's three
-// components, gathered from and scattered to the models' arrays through an index list, or a row
-// of a sparse product): a row costs several times a plain per-DE update, so a loop of a thousand
-// rows already takes several times what entering a parallel region costs (bench_omp_regions). The
-// coupled fabric's 2 502 coupled DEs and the coupled DCB's ~3 000 ran on one thread below
-// parallel_threshold (docs/performance.md#coupling-rows).
+// components, or a factor's row, gathered and scattered through an index list or a permutation;
+// its sparse products keep parallel_threshold, on their entries): a row costs several times a
+// plain per-DE update, so a loop of a thousand rows already takes several times what entering a
+// parallel region costs (bench_omp_regions). The coupled fabric's 2 502 coupled DEs and the
+// following DCB band's ~3 000 lie between the two bounds (docs/performance.md#coupling-rows).
 inline constexpr long parallel_threshold_rows = 1024;
 // The same for bonds, per colour of a bond set on average (dem::BondColouring). A bond costs
 // 10-100 times a DE's update: a random packing's bond sets colour into ~20 colours of a few
