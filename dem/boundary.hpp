@@ -37,6 +37,9 @@ struct BoundaryCondition {
   bool kinematic() const {
     return kind == BoundaryKind::fixed || kind == BoundaryKind::velocity || kind == BoundaryKind::displacement;
   }
+  // Kinematic with no motion at any time (fixed, or a zero velocity or displacement): its DEs'
+  // imposed components stay at rest, so their kinetic energy and their reactions' work are 0.
+  bool still() const { return kind == BoundaryKind::fixed || (kinematic() && value == Vec3{}); }
   Vec3 displacement_at(double t) const;
   Vec3 velocity_at(double t) const;
 };

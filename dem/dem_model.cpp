@@ -109,6 +109,14 @@ void DemModel::finalize() {
     }
   }
   constraint_reaction_.assign(constraints_.size(), Vec3{});
+  moving_constraints_.clear();
+  still_constraints_.clear();
+  for (std::size_t k = 0; k < constraints_.size(); ++k)
+    (boundaries_[constraints_[k].condition].still() ? still_constraints_ : moving_constraints_).push_back(static_cast<std::uint32_t>(k));
+  // A still condition's DEs start at rest along what it imposes (the first step would stop them):
+  // from here on their kinetic energy there is 0, so driven_kinetic_energy and the work of
+  // their reactions skip them.
+  for (const std::uint32_t k : still_constraints_) impose(constraints_[k], Vec3{});
   condition_velocity_.assign(boundaries_.size(), Vec3{});
   watched_members_.clear();
   for (const int g : watched_)
@@ -325,17 +333,21 @@ void DemModel::impose_motion(double t, bool half_step, double dt) {
     if (bc.kinematic())
       condition_velocity_[k] = half_step ? (bc.displacement_at(t + dt) - bc.displacement_at(t)) / dt : bc.velocity_at(t);
   }
-  for (const Constraint& c : constraints_) {
-    const Vec3& v = condition_velocity_[c.condition];
-    for (int k = 0; k < 3; ++k)
-      if (c.imposed >> k & 1) particles.velocity[c.particle][k] = v[k];
-    if (c.imposed & 8) particles.angular_velocity[c.particle] = {};
-  }
+  for (const std::uint32_t k : moving_constraints_) impose(constraints_[k], condition_velocity_[constraints_[k].condition]);
+  for (const std::uint32_t k : still_constraints_) impose(constraints_[k], Vec3{});
+}
+
+void DemModel::impose(const Constraint& c, const Vec3& v) {
+  for (int k = 0; k < 3; ++k)
+    if (c.imposed >> k & 1) particles.velocity[c.particle][k] = v[k];
+  if (c.imposed & 8) particles.angular_velocity[c.particle] = {};
 }
 
 double DemModel::driven_kinetic_energy() const {
+  // Still conditions' DEs are at rest along their imposed components: no term.
   double e = 0.0;
-  for (const Constraint& c : constraints_) {
+  for (const std::uint32_t index : moving_constraints_) {
+    const Constraint& c = constraints_[index];
     const Vec3& v = particles.velocity[c.particle];
     for (int k = 0; k < 3; ++k)
       if (c.imposed >> k & 1) e += 0.5 * c.mass * v[k] * v[k];
@@ -464,8 +476,9 @@ void DemModel::record_reactions() {
   const PhaseTimer timer(profile_, phase_.boundary, false);
   // Reaction R = -(bond + contact forces) on each driven DE; over the drift it did the
   // trapezoidal work (R(n) + R(n+1))/2 . dt v(n+1/2).
-  // Only the imposed components: forces along free ones move the DE like any other.
-  for (std::size_t k = 0; k < constraints_.size(); ++k) {
+  // Only the imposed components: forces along free ones move the DE like any other. A still
+  // condition's reactions do no work: its DEs do not move along them.
+  for (const std::uint32_t k : moving_constraints_) {
     const std::uint32_t i = constraints_[k].particle;
     Vec3 reaction{};
     for (int d = 0; d < 3; ++d)

@@ -230,6 +230,7 @@ class DemModel {
     double mass;              // the DE's (weighted) mass, kg, for the driven kinetic energy
     std::uint8_t imposed;     // bits 0-2: the condition imposes x, y, z; bit 3: it locks rotation
   };
+  void impose(const Constraint& c, const Vec3& v);  // c's imposed components of its DE's velocity = v
   std::vector<std::string> group_names_;
   std::vector<std::vector<std::uint32_t>> group_members_;  // per group, increasing DE indices
   std::vector<std::unique_ptr<BondSet>> bond_sets_;
@@ -250,6 +251,9 @@ class DemModel {
   std::vector<BreakEvent> held_failures_;
   std::vector<BoundaryCondition> boundaries_;
   std::vector<Constraint> constraints_;  // kinematic, one per constrained DE
+  // Indices into constraints_: those of moving conditions (the imposed velocity, the driven
+  // kinetic energy and the reactions' work), and of still ones (only held at rest, impose_motion).
+  std::vector<std::uint32_t> moving_constraints_, still_constraints_;
   std::vector<Vec3> constraint_reaction_;  // last reaction per constraint (for its work)
   std::vector<Vec3> condition_velocity_;   // scratch of impose_motion: per boundary condition, m/s
   // (DE, group) for every DE of a watched group, in DE order: record_reactions' sums.

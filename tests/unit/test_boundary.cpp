@@ -32,5 +32,26 @@ TEST(Boundary, VelocityRiseIsSmoothAndItsDisplacementIsTheIntegral) {
   EXPECT_NEAR(bc.displacement_at(1e-6).z, 2e-6, 1e-18);
 }
 
+// A still condition never moves its DEs (the model then skips their kinetic energy and work):
+// fixed, or a kinematic condition whose value is zero; not a moving or a force condition.
+TEST(Boundary, StillConditionsAreTheOnesThatNeverMove) {
+  BoundaryCondition bc;
+  bc.kind = BoundaryKind::fixed;
+  EXPECT_TRUE(bc.still());
+  bc.kind = BoundaryKind::velocity;
+  EXPECT_TRUE(bc.still());
+  bc.value = {0.0, 1e-9, 0.0};
+  EXPECT_FALSE(bc.still());
+  bc.kind = BoundaryKind::displacement;
+  bc.ramp = 1e-6;
+  EXPECT_FALSE(bc.still());
+  bc.value = {};
+  EXPECT_TRUE(bc.still());
+  bc.kind = BoundaryKind::force;
+  EXPECT_FALSE(bc.still());
+  bc.kind = BoundaryKind::free;
+  EXPECT_FALSE(bc.still());
+}
+
 }  // namespace
 }  // namespace arlequin::dem
