@@ -661,10 +661,10 @@ class Part final : public ContinuumPart {
       solver_->add_traction(group, [t = bc.value](const Vec3&, double) { return t; });
       return;
     }
-    continuum::VectorFunction g = [](const Vec3&, double) { return Vec3{}; };
-    if (bc.kind == "displacement") {
+    continuum::VectorFunction g;  // none for fixed or a zero motion: a still support (ContinuumSolver::fix)
+    if (bc.kind == "displacement" && bc.value != Vec3{}) {
       g = [u = bc.value](const Vec3&, double) { return u; };
-    } else if (bc.kind == "velocity") {
+    } else if (bc.kind == "velocity" && bc.value != Vec3{}) {
       // Velocity v with the DEM's rise (common/rise.hpp) until `duration`, then held: g(t) is its
       // integral. One rise for both: a coupled run's load strips then move as the pure DEM's load
       // DEs do.

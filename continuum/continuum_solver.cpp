@@ -292,7 +292,11 @@ void ContinuumSolver::fix(const std::string& group, std::array<bool, 3> componen
       is_fixed_[dof] = 1;
       kick_inverse_mass_[dof] = 0.0;
       u_[dof] = prescribed(*it, t_);
+      if (!g) v_[dof] = 0.0;  // still: at rest from here on (the first drift stopped it before)
     }
+  moving_fixed_.clear();
+  for (std::size_t k = 0; k < fixed_.size(); ++k)
+    if (fixed_[k].g) moving_fixed_.push_back(static_cast<int>(k));
 }
 
 void ContinuumSolver::set_initial_displacement(const Field& u0) {
@@ -305,7 +309,7 @@ void ContinuumSolver::set_initial_displacement(const Field& u0) {
 }
 
 double ContinuumSolver::prescribed(const Fixed& f, double t) const {
-  return f.start + f.g(nodes()[f.dof / 3], t)[f.dof % 3];
+  return f.g ? f.start + f.g(nodes()[f.dof / 3], t)[f.dof % 3] : f.start;
 }
 
 void ContinuumSolver::add_traction(const std::string& group, VectorFunction traction) {
@@ -435,10 +439,17 @@ void ContinuumSolver::kick(double dt) {
 
 void ContinuumSolver::drift(double dt) {
   t_ += dt;
-  for (const Fixed& f : fixed_) v_[f.dof] = (prescribed(f, t_) - u_[f.dof]) / dt;  // from u before the drift
+  // A still support's dofs keep u0 and zero velocity through the drift as they are.
+  for (int k : moving_fixed_) {  // from u before the drift
+    const Fixed& f = fixed_[static_cast<std::size_t>(k)];
+    v_[f.dof] = (prescribed(f, t_) - u_[f.dof]) / dt;
+  }
   const long n = static_cast<long>(u_.size());
   for_each_index(n, n > parallel_threshold, [this, dt](long d) { u_[d] += dt * v_[d]; });
-  for (const Fixed& f : fixed_) u_[f.dof] = prescribed(f, t_);
+  for (int k : moving_fixed_) {
+    const Fixed& f = fixed_[static_cast<std::size_t>(k)];
+    u_[f.dof] = prescribed(f, t_);
+  }
 }
 
 void ContinuumSolver::begin_step_work() {
@@ -450,10 +461,11 @@ void ContinuumSolver::begin_step_work() {
     step_f_ext_.assign(u_.size(), 0.0);
     add_external_force(step_f_ext_);
   }
-  step_fixed_u_.resize(fixed_.size());
-  step_f_fixed_.resize(fixed_.size());
-  for (std::size_t k = 0; k < fixed_.size(); ++k) {
-    const int d = fixed_[k].dof;
+  // The moving supports' work; a still support's is zero (its dofs neither move nor have speed).
+  step_fixed_u_.resize(moving_fixed_.size());
+  step_f_fixed_.resize(moving_fixed_.size());
+  for (std::size_t k = 0; k < moving_fixed_.size(); ++k) {
+    const int d = fixed_[static_cast<std::size_t>(moving_fixed_[k])].dof;
     step_work_ -= 0.5 * dof_mass_[d] * v_[d] * v_[d];
     step_fixed_u_[k] = u_[d];
     step_f_fixed_[k] = f_[d];
@@ -466,8 +478,8 @@ void ContinuumSolver::end_step_work() {
     add_external_force(step_f_ext_new_);
     for (std::size_t d = 0; d < u_.size(); ++d) step_work_ += 0.5 * (step_f_ext_[d] + step_f_ext_new_[d]) * (u_[d] - step_u_[d]);
   }
-  for (std::size_t k = 0; k < fixed_.size(); ++k) {
-    const int d = fixed_[k].dof;
+  for (std::size_t k = 0; k < moving_fixed_.size(); ++k) {
+    const int d = fixed_[static_cast<std::size_t>(moving_fixed_[k])].dof;
     step_work_ += 0.5 * dof_mass_[d] * v_[d] * v_[d] - 0.5 * (step_f_fixed_[k] + f_[d]) * (u_[d] - step_fixed_u_[k]);
   }
   external_work_ += step_work_;

@@ -111,8 +111,11 @@ class ContinuumSolver {
   virtual InterpolationOperator interpolation(const std::vector<Vec3>& points) const = 0;
 
   // Fixes `components` of every node of `group` to u0 + g(X, t) (applied now and at every
-  // drift), u0 the initial displacement (0 unless set_initial_displacement).
-  void fix(const std::string& group, std::array<bool, 3> components, VectorFunction g);
+  // drift), u0 the initial displacement (0 unless set_initial_displacement). Without g (or with
+  // an empty one) the support is still: its dofs stay at u0 with zero velocity, and the steps
+  // skip them (their support work is zero), so whoever writes velocity() or displacement() must
+  // leave held dofs as they are (the coupling's corrections and relaxation write free dofs only).
+  void fix(const std::string& group, std::array<bool, 3> components, VectorFunction g = {});
   // Starts from u0 (one value per dof): a pre-strained state. Essential conditions, set before
   // or after, prescribe their g on top of it, as the DEM's boundary conditions move DEs from
   // where they start.
@@ -230,7 +233,7 @@ class ContinuumSolver {
   };
   struct Fixed {
     int dof;
-    VectorFunction g;
+    VectorFunction g;    // empty: a still support
     double start = 0.0;  // the initial displacement of the dof, m
   };
   // H_q = sum_a u_a (x) grad_q N_a (row: displacement component, column: derivative).
@@ -265,6 +268,7 @@ class ContinuumSolver {
   std::vector<double> mass_;
   std::vector<double> dof_mass_;
   std::vector<Fixed> fixed_;
+  std::vector<int> moving_fixed_;  // fixed_'s entries with a g: the ones a step imposes and whose work it sums
   Field initial_u_;  // set_initial_displacement's u0 (empty: zero)
   std::vector<char> is_fixed_;  // per dof
   std::vector<double> kick_inverse_mass_;  // per dof: 1 / dof_mass_, 0 where fixed (what a kick multiplies f by)
