@@ -34,6 +34,23 @@ double worst_balance(const std::vector<std::map<std::string, std::string>>& rows
   return worst;
 }
 
+// The largest |v - v_reference| of the sphere over `rows`, the reference's velocity taken at each
+// row's time by linear interpolation between its own rows (m/s).
+double largest_velocity_difference(const std::vector<std::map<std::string, std::string>>& reference,
+                                   const std::vector<std::map<std::string, std::string>>& rows) {
+  double largest = 0.0;
+  std::size_t k = 1;
+  for (const auto& row : rows) {
+    const double t = at(row, "time");
+    while (k + 1 < reference.size() && at(reference[k], "time") < t) ++k;
+    const double t0 = at(reference[k - 1], "time"), t1 = at(reference[k], "time");
+    const double s = t1 > t0 ? std::clamp((t - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+    const double v = (1.0 - s) * at(reference[k - 1], "sphere_velocity") + s * at(reference[k], "sphere_velocity");
+    largest = std::max(largest, std::abs(at(row, "sphere_velocity") - v));
+  }
+  return largest;
+}
+
 // The reduced impact with `sets` (--set options) run into the scratch folder `name` (out): its
 // series rows, none if the run failed (which is reported).
 std::vector<std::map<std::string, std::string>> run_reduced(const std::string& name, const std::string& sets,
@@ -342,25 +359,32 @@ void expect_within_the_issues_bounds(const Json& report, double first_break, con
 }
 
 // Validation: the coupled seed target against the pure-DEM run, both with breakage, with the
-// plate in P2 elements (the case's) and in natural neighbours (`--set-other
+// plate in P1 elements (the case's) and in natural neighbours (`--set-other
 // continuum.solver=nem`: the plate with the patch's hole as eight convex pieces). One comparison
 // is one draw (docs/decisions.md#d43), so the issue's bounds are asserted on the medians of seven
-// pairs (`arlequin compare --ensemble 7`, d44; about 4 minutes each): the sphere's velocity
+// pairs (`arlequin compare --ensemble 7`, d44; about 3 and 5 minutes): the sphere's velocity
 // history within 5 % (max over the 100 us of the difference relative to its largest value:
-// measured 3.47 % with fe, the pairs 0.92 to 6.62 %, and 1.90 % with nem, the pure run against
-// itself up to 2.27 %), the peak impact force within 10 % (rows every 0.1 us; measured -0.37 %
-// with fe and -2.35 % with nem; a build of the same model on another machine drew -10.47 % and
-// -10.28 % and failed here: the median of seven pairs is still a draw to about ten points, the
-// pure run's own peak spreading over -2.9 to +7.5 %, cases/fabric_impact_coupled/README.md), the
-// first break within 10 % (measured -0.48 % and -0.49 %); and without breakage the coupled
-// balance within 1 % of the impact energy.
+// measured 4.59 % with fe, the pairs 2.56 to 6.15 %, and 4.69 % with nem, the pure run against
+// itself up to 4.08 %), the peak impact force within 10 % (rows every 0.1 us; measured -3.16 %
+// with fe and -6.07 % with nem; a build of an earlier model on another machine drew -10.47 % and
+// -10.28 %: the median of seven pairs is still a draw to about ten points, the pure run's own
+// peak spreading over -17 to +1.6 %, cases/fabric_impact_coupled/README.md), the first break
+// within 10 % (measured -0.86 % and -2.04 %). Without breakage, the model's own error (d43): the
+// sphere within 5 % of 90 m/s of the pure run's (measured 2.37 % with fe and 2.42 % with nem;
+// nem on the nodes of P2 elements, 10.1 %, failed it: d62), and the coupled balance within 1 %
+// of the impact energy (measured 2.3e-4).
 TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
+  const std::string pure = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/fabric_impact/case.yaml";
+  const auto pure_unbreakable = test::scratch_dir("fabric_pure_seed_unbreakable");
+  const auto p = test::run_arlequin("run " + pure + " --set dem.sample.yarn.failure_strain=0 --set output.fields=[] --out " +
+                                    pure_unbreakable.string());
+  ASSERT_EQ(p.exit_code, 0) << p.output;
+  const auto pure_rows = test::read_csv(pure_unbreakable / "series.csv");
   for (const std::string solver : {"fe", "nem"}) {
     const auto out = test::scratch_dir("fabric_compare_" + solver);
-    const std::string pure = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/fabric_impact/case.yaml";
     const auto r = test::run_arlequin("compare " + pure + " " + coupled_dir + "case.yaml --ensemble 7 --set output.fields=[] " +
                                       "--set-other continuum.solver=" + solver + " --out " + out.string());
     ASSERT_EQ(r.exit_code, 0) << solver << ": " << r.output;
@@ -372,7 +396,9 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
     const auto u = test::run_arlequin("run " + coupled_dir + "case.yaml --set dem.sample.yarn.failure_strain=0 --set output.fields=[] " +
                                       "--set continuum.solver=" + solver + " --out " + unbreakable.string());
     ASSERT_EQ(u.exit_code, 0) << solver << ": " << u.output;
-    EXPECT_LT(worst_balance(test::read_csv(unbreakable / "series.csv")), 0.01 * impact_energy()) << solver;
+    const auto rows = test::read_csv(unbreakable / "series.csv");
+    EXPECT_LT(largest_velocity_difference(pure_rows, rows), 0.05 * 90.0) << solver;
+    EXPECT_LT(worst_balance(rows), 0.01 * impact_energy()) << solver;
   }
 }
 
