@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "common/error.hpp"
 
@@ -60,22 +61,32 @@ struct CaseState {
   // Views refer to their mapping by index: assigning a YAML::Node rebinds the node it
   // shares data with, so views never hold one themselves (that makes CaseNode assignable).
   std::vector<YAML::Node> nodes;
-  std::vector<std::pair<std::string, std::string>> overrides;  // key path -> "--set ..." text
+  // Where the entries under a key path came from, in the order they were put there: a base case
+  // (`extends`) and the files over it, whose lines the entries carry, then the "--set ..."
+  // overrides, which have none. The empty path stands for every entry.
+  struct Origin {
+    std::string prefix;
+    std::string where;  // a file as given, or the override's text
+    bool has_lines;
+  };
+  std::vector<Origin> origins;
   CaseRecord resolved;
   const Schema* schema = nullptr;  // checks every key read, when given
 
-  // "--set ..." if an override provided `path` (or a mapping above it), else "file:line".
+  // "--set ..." if an override provided `path` (or a mapping above it), else "file:line" of the
+  // file that provided it (the case's own file unless it extends another).
   std::string location(std::string_view path, int line) const {
-    const std::string* best = nullptr;
+    const Origin* best = nullptr;
     std::size_t best_len = 0;
-    for (const auto& [prefix, text] : overrides) {
-      const bool covers = path.starts_with(prefix) &&
-                          (path.size() == prefix.size() || path[prefix.size()] == '.' ||
-                           path[prefix.size()] == '[');
-      if (covers && prefix.size() >= best_len) best = &text, best_len = prefix.size();
+    for (const Origin& o : origins) {
+      const std::string_view prefix = o.prefix;
+      const bool covers = prefix.empty() || (path.starts_with(prefix) &&
+                                             (path.size() == prefix.size() || path[prefix.size()] == '.' ||
+                                              path[prefix.size()] == '['));
+      if (covers && prefix.size() >= best_len) best = &o, best_len = prefix.size();
     }
-    if (best) return *best;
-    return file.string() + (line > 0 ? ":" + std::to_string(line) : "");
+    const bool has_lines = !best || best->has_lines;
+    return (best ? best->where : file.string()) + (has_lines && line > 0 ? ":" + std::to_string(line) : "");
   }
 };
 
@@ -243,7 +254,7 @@ void apply_override(detail::CaseState& s, const Override& o) {
     const YAML::Node next = map[keys[i]];
     if (!next.IsDefined() || next.IsNull()) {
       map[keys[i]] = YAML::Node(YAML::NodeType::Map);
-      s.overrides.emplace_back(at, where);  // the new mapping and everything in it came from here
+      s.origins.push_back({at, where, false});  // the new mapping and everything in it came from here
     } else if (!next.IsMap()) {
       raise(where, "", "'" + at + "' is " + describe(next) + ", not a mapping");
     }
@@ -251,7 +262,106 @@ void apply_override(detail::CaseState& s, const Override& o) {
     map.reset(inner);
   }
   map[keys.back()] = value;
-  s.overrides.emplace_back(at, where);
+  s.origins.push_back({at, where, false});
+}
+
+// The keys of a mapping in order, each checked to be a plain name given once: yaml-cpp accepts
+// duplicate keys and silently keeps the first. `where(key path, line)` places a message.
+template <class Where>
+std::vector<std::string> checked_keys(const YAML::Node& map, const std::string& path, const Where& where) {
+  std::vector<std::string> keys;
+  std::vector<int> lines;
+  if (!map.IsMap()) return keys;
+  for (const auto& kv : map) {
+    const int line = line_of(kv.first);
+    if (!kv.first.IsScalar()) raise(where(path, line), path, "keys must be plain names");
+    const std::string& key = kv.first.Scalar();
+    const std::string at = path.empty() ? key : path + "." + key;
+    const auto seen = std::find(keys.begin(), keys.end(), key);
+    if (seen != keys.end())
+      raise(where(at, line), at, "duplicate key (first given at line " + std::to_string(lines[seen - keys.begin()]) + ")");
+    keys.push_back(key);
+    lines.push_back(line);
+  }
+  return keys;
+}
+
+std::string file_line(const std::string& file, int line) { return file + (line > 0 ? ":" + std::to_string(line) : ""); }
+
+// The mapping `over` (a case that extends another, read from `file`) laid over `base`: mappings
+// present in both are merged key by key, any other value replaces the base's, and a key given
+// no value removes the base's entry (its default then applies). The keys keep the base's order
+// (a region's materials are looked up in order), the new ones after them, and every key its own
+// file's node, so that its line is that file's; where each value laid over came from is recorded.
+YAML::Node laid_over(detail::CaseState& s, const YAML::Node& base, const YAML::Node& over, const std::string& path,
+                     const std::string& file) {
+  const auto in_file = [&file](const std::string&, int line) { return file_line(file, line); };
+  const std::vector<std::string> keys = checked_keys(over, path, in_file);
+  std::vector<YAML::Node> key_nodes;
+  for (const auto& kv : over) key_nodes.push_back(kv.first);
+  std::vector<bool> placed(keys.size(), false);
+  YAML::Node out(YAML::NodeType::Map);
+  const auto put = [&](std::size_t k) {
+    const YAML::Node value = over[keys[k]];
+    placed[k] = true;
+    if (!value.IsDefined() || value.IsNull()) return;  // removed
+    out.force_insert(key_nodes[k], value);
+    s.origins.push_back({path.empty() ? keys[k] : path + "." + keys[k], file, true});
+  };
+  for (const auto& kv : base) {
+    const auto k = static_cast<std::size_t>(std::find(keys.begin(), keys.end(), kv.first.Scalar()) - keys.begin());
+    if (k == keys.size()) {
+      out.force_insert(kv.first, kv.second);
+    } else if (const YAML::Node value = over[keys[k]]; value.IsMap() && kv.second.IsMap()) {
+      placed[k] = true;
+      out.force_insert(kv.first, laid_over(s, kv.second, value, path.empty() ? keys[k] : path + "." + keys[k], file));
+    } else {
+      put(k);
+    }
+  }
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    if (!placed[k]) put(k);
+  return out;
+}
+
+// Parses a case file; when it names a base case (`extends: base.yaml`, in the same folder, so
+// that relative paths in both are read from one place), reads that first (itself possibly
+// extending another) and lays this file's entries over it. `chain`: the files that extend this
+// one, to refuse a cycle.
+YAML::Node read_document(detail::CaseState& s, const std::filesystem::path& file, std::vector<std::filesystem::path>& chain) {
+  const std::string text = read_text(file);
+  YAML::Node doc;
+  try {
+    doc.reset(YAML::Load(text));
+  } catch (const YAML::Exception& e) {
+    raise(file_line(file.string(), e.mark.is_null() ? 0 : e.mark.line + 1), "", "YAML syntax error: " + e.msg);
+  }
+  if (!doc.IsMap() && !doc.IsNull())
+    raise(file_line(file.string(), line_of(doc)), "", "expected a mapping of sections at the top level, got " + describe(doc));
+  const YAML::Node base_name = doc.IsMap() ? std::as_const(doc)["extends"] : YAML::Node();
+  if (!base_name.IsDefined()) {
+    if (!chain.empty()) s.origins.push_back({"", file.string(), true});  // a base: its entries carry its lines
+    return doc;
+  }
+  const std::string where = file_line(file.string(), line_of(base_name));
+  const std::filesystem::path name = base_name.IsScalar() ? std::filesystem::path(base_name.Scalar()) : std::filesystem::path();
+  if (name.empty() || name.has_parent_path())
+    raise(where, "extends", "expected the file name of a case in this case's folder (relative paths in both are read from it), got " +
+                                describe(base_name));
+  const std::filesystem::path base = file.parent_path() / name;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(base, ec)) raise(where, "extends", "no case file " + base.string());
+  chain.push_back(file);
+  for (const auto& f : chain)
+    if (std::filesystem::equivalent(f, base, ec)) {
+      std::string cycle;
+      for (const auto& g : chain) cycle += g.filename().string() + " -> ";
+      raise(where, "extends", "the cases extend one another: " + cycle + name.string());
+    }
+  const YAML::Node below = read_document(s, base, chain);
+  chain.pop_back();
+  doc.remove("extends");
+  return laid_over(s, below, doc, "", file.string());
 }
 
 }  // namespace
@@ -375,17 +485,7 @@ CaseNode CaseNode::open(const std::shared_ptr<detail::CaseState>& state, const E
   CaseNode node(state, state->nodes.size(), e.path, e.line, &record);
   if (!e.value.IsMap() && !e.value.IsNull()) node.mismatch(e, "a mapping");
   state->nodes.push_back(e.value);
-  std::vector<std::pair<std::string, int>> seen;
-  for (const auto& kv : e.value.IsMap() ? e.value : YAML::Node(YAML::NodeType::Map)) {
-    const int line = line_of(kv.first);
-    if (!kv.first.IsScalar()) raise(state->location(e.path, line), e.path, "keys must be plain names");
-    const std::string& key = kv.first.Scalar();
-    auto it = std::find_if(seen.begin(), seen.end(), [&](auto& s) { return s.first == key; });
-    if (it != seen.end())
-      raise(state->location(node.key_path(key), line), node.key_path(key),
-            "duplicate key (first given at line " + std::to_string(it->second) + ")");
-    seen.emplace_back(key, line);
-  }
+  checked_keys(e.value, e.path, [&state](const std::string& at, int line) { return state->location(at, line); });
   return node;
 }
 
@@ -845,15 +945,8 @@ CaseFile CaseFile::load(const std::filesystem::path& file, const std::vector<Ove
   state->schema = schema;
   state->file = file;
   state->folder = std::filesystem::absolute(file).lexically_normal().parent_path();
-  const std::string text = read_text(file);
-  try {
-    state->doc.reset(YAML::Load(text));
-  } catch (const YAML::Exception& e) {
-    raise(state->location("", e.mark.is_null() ? 0 : e.mark.line + 1), "", "YAML syntax error: " + e.msg);
-  }
-  if (!state->doc.IsMap() && !state->doc.IsNull())
-    raise(state->location("", line_of(state->doc)), "",
-          "expected a mapping of sections at the top level, got " + describe(state->doc));
+  std::vector<std::filesystem::path> chain;
+  state->doc.reset(read_document(*state, file, chain));
   for (const auto& o : overrides) apply_override(*state, o);
   return CaseFile(std::move(state));
 }

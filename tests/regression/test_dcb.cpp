@@ -225,6 +225,7 @@ TEST(Dcb, ReducedDcbPropagatesAlongLefmAndBalancesEnergy) {
 // at 110 GPa against +1.2 % at 135). Their arms are P1 (the case's are P2, d48), forced every
 // step: the bounds below were measured so.
 const std::string coupled_case = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/dcb_coupled/case.yaml";
+const std::string following_case = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/dcb_coupled/following.yaml";
 const std::string reduced_coupled =
     " --quiet --set dem.sample.radius.mean=2.8e-4 --set dem.sample.file=../dcb/results/dcb_reduced/sample.h5"
     " --set continuum.material.E=135.0e9"
@@ -385,16 +386,16 @@ AgainstPureDem against_pure_dem(const std::filesystem::path& pure, const std::fi
   return c;
 }
 
-// The coupled DCB of the case file with `overrides` against the pure-DEM 40k run of
+// The coupled DCB of `case_file` with `overrides` against the pure-DEM 40k run of
 // Dcb40kMatchesR5 (the fixture; a failed gate there leaves these not run): the 5 % on the
 // load (d51), the peak and the dissipation, and R5's gates. The compute-time ratio is printed, not
 // gated: the band keeps a quarter of the DEs (cases/dcb_coupled/README.md).
-void expect_within_five_percent_of_the_pure_dem(const std::string& name, const std::string& overrides) {
+void expect_within_five_percent_of_the_pure_dem(const std::string& name, const std::string& case_file, const std::string& overrides) {
   const auto pure = test::scratch_path(pure_dcb_40k);
   ASSERT_TRUE(std::filesystem::exists(pure / "summary.json"))
       << "no pure-DEM run in " << pure << ": run ValidationDcb.Dcb40kMatchesR5 first (ctest does)";
   const auto out = test::scratch_dir(name);
-  const auto r = test::run_arlequin("run " + coupled_case + " --quiet --set output.fields=[] " + overrides + " --out " + out.string());
+  const auto r = test::run_arlequin("run " + case_file + " --quiet --set output.fields=[] " + overrides + " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   expect_r5_gates(out / "series.csv");
   const AgainstPureDem c = against_pure_dem(pure, out);
@@ -415,7 +416,7 @@ TEST(ValidationDcb, CoupledDcb40kFeWithinFivePercentOfThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
-  expect_within_five_percent_of_the_pure_dem("dcb_coupled_40k_fe", "");
+  expect_within_five_percent_of_the_pure_dem("dcb_coupled_40k_fe", coupled_case, "");
 }
 
 // Natural neighbours on the same nodes, their force every third step (their critical step is 6.7
@@ -427,11 +428,11 @@ TEST(ValidationDcb, CoupledDcb40kNemWithinFivePercentOfThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
-  expect_within_five_percent_of_the_pure_dem("dcb_coupled_40k_nem",
+  expect_within_five_percent_of_the_pure_dem("dcb_coupled_40k_nem", coupled_case,
                                               "--set continuum.solver=nem --set coupling.continuum_substeps=3");
 }
 
-// The band that follows the crack (README.md's fast configuration, docs/decisions.md#d56, #d59):
+// The band that follows the crack (following.yaml, the fast configuration; docs/decisions.md#d56, #d59):
 // arms of 1.5 mm along x and 3 mm across, a band 0.4 mm thick on each side with 0.2 mm overlaps
 // (mass floor 0.3), from 12 to 27 mm, growing 8 mm ahead of the damage front when it comes within
 // 4 mm of the band's end, its start 5 mm behind the crack tip, both up to the specimen's end; to
@@ -442,14 +443,7 @@ TEST(ValidationDcb, FollowingBandDcb40kFeWithinFivePercentOfThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
-  expect_within_five_percent_of_the_pure_dem(
-      "dcb_following_40k_fe",
-      "--set 'output={every: 1.0e-5, fields: []}' --set time.end=2.1e-3"
-      " --set continuum.mesh.file=../../meshes/dcb_arms_1p5x3mm.geo --set coupling.continuum_substeps=auto"
-      " --set coupling.overlap.band.half_thickness=4.0e-4 --set coupling.overlap.band.width=2.0e-4 --set coupling.mass_floor=0.3"
-      " --set coupling.overlap.band.to=0.027 --set dem.interface.bond.area=0.9e-4"
-      " --set 'continuum.mesh.join={box: [[0.0269, -1, -1], [1, 1, 1]]}'"
-      " --set 'coupling.overlap.band.follow={margin: 4.0e-3, ahead: 8.0e-3, behind: 5.0e-3, until: 0.045}'");
+  expect_within_five_percent_of_the_pure_dem("dcb_following_40k_fe", following_case, "--set time.end=2.1e-3");
 }
 
 }  // namespace

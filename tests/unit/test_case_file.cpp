@@ -268,6 +268,72 @@ TEST_F(CaseFileTest, OverriddenValuesReportTheOverride) {
   EXPECT_CONTAINS(dem.child("sample").where(), "case.yaml:5");
 }
 
+// A variant case names its base (`extends`) and gives only what differs: mappings merge key by
+// key, other values replace the base's, a key with no value removes the base's entry; --set goes
+// over both.
+TEST_F(CaseFileTest, ExtendsLaysTheVariantOverItsBase) {
+  write(kCase, "base.yaml");
+  const fs::path variant = write("extends: base.yaml\n"
+                                 "time: {end: 2e-3}\n"
+                                 "dem:\n"
+                                 "  sample: {radius: 0.002, shape: sphere}\n"
+                                 "  gravity:\n"
+                                 "output: {fields: [c]}\n",
+                                 "variant.yaml");
+  CaseFile c = CaseFile::load(variant, {"time.steps=10"});
+  CaseNode root = c.root();
+  CaseNode time = root.child("time");
+  EXPECT_DOUBLE_EQ(time.number("end", Range::positive(), "s"), 2e-3);  // the variant's
+  EXPECT_EQ(time.integer("steps", Range::at_least(1)), 10);            // --set's over the base's 200
+  CaseNode dem = root.child("dem");
+  CaseNode sample = dem.child("sample");
+  EXPECT_DOUBLE_EQ(sample.number("radius", Range::positive(), "m"), 0.002);
+  EXPECT_DOUBLE_EQ(sample.number("density", Range::positive(), "kg/m^3"), 2500);  // kept from the base
+  EXPECT_EQ(sample.string("shape"), "sphere");                                     // added
+  EXPECT_FALSE(dem.has("gravity"));                                                // removed
+  EXPECT_TRUE(dem.boolean("periodic"));
+  EXPECT_EQ(root.child("output").strings("fields"), (std::vector<std::string>{"c"}));  // a list is replaced whole
+  EXPECT_FALSE(root.has("extends"));
+  EXPECT_EQ(c.path(), variant);
+}
+
+// An error names the file and line its entry came from: the base's, the variant's or --set's.
+TEST_F(CaseFileTest, ExtendedEntriesReportTheFileTheyCameFrom) {
+  write("time: {end: 1e-3}\ndem:\n  sample:\n    radius: -1\n    density: 2500\n", "base.yaml");
+  write("extends: base.yaml\ndem:\n  sample:\n    density: -3\n  contakt: {}\n", "middle.yaml");
+  const fs::path variant = write("extends: middle.yaml\ntime: {end: x}\n", "variant.yaml");
+  CaseFile c = CaseFile::load(variant, {"dem.sample.seed=-2"});
+  CaseNode root = c.root();
+  EXPECT_CONTAINS(error_of([&] { root.child("time").number("end", Range::positive(), "s"); }),
+                  "variant.yaml:2: time.end: expected a number > 0 [s], got 'x'");
+  CaseNode dem = root.child("dem");
+  CaseNode sample = dem.child("sample");
+  EXPECT_CONTAINS(error_of([&] { sample.number("radius", Range::positive(), "m"); }),
+                  "base.yaml:4: dem.sample.radius: expected a number > 0 [m], got -1");
+  EXPECT_CONTAINS(error_of([&] { sample.number("density", Range::positive(), "kg/m^3"); }),
+                  "middle.yaml:4: dem.sample.density: expected a number > 0 [kg/m^3], got -3");
+  EXPECT_CONTAINS(error_of([&] { sample.integer("seed", Range::at_least(0)); }), "--set dem.sample.seed=-2: dem.sample.seed:");
+  EXPECT_FALSE(dem.has("contact"));
+  EXPECT_CONTAINS(error_of([&] { dem.finish(); }), "middle.yaml:5: dem.contakt: unknown key; did you mean 'contact'?");
+}
+
+TEST_F(CaseFileTest, ABadExtendsIsNamed) {
+  write("time: {end: 1e-3}\n", "base.yaml");
+  const auto message = [&](const std::string& text) { return error_of([&] { CaseFile::load(write(text, "v.yaml")); }); };
+  EXPECT_CONTAINS(message("a: 1\nextends: nope.yaml\n"), "v.yaml:2: extends: no case file ");
+  EXPECT_CONTAINS(message("extends: sub/variant.yaml\n"),
+                  "v.yaml:1: extends: expected the file name of a case in this case's folder (relative paths in both are "
+                  "read from it), got 'sub/variant.yaml'");
+  EXPECT_CONTAINS(message("extends: [base.yaml]\n"), "v.yaml:1: extends: expected the file name of a case");
+  EXPECT_CONTAINS(message("extends: base.yaml\ntime: {end: 1}\ntime: {end: 2}\n"),
+                  "v.yaml:3: time: duplicate key (first given at line 2)");
+  write("extends: b.yaml\n", "a.yaml");
+  write("extends: a.yaml\n", "b.yaml");
+  EXPECT_CONTAINS(error_of([&] { CaseFile::load(dir_ / "a.yaml"); }),
+                  "b.yaml:1: extends: the cases extend one another: a.yaml -> b.yaml -> a.yaml");
+  EXPECT_CONTAINS(message("extends: v.yaml\n"), "v.yaml:1: extends: the cases extend one another: v.yaml -> v.yaml");
+}
+
 TEST_F(CaseFileTest, ListItemsHavePathsAndLines) {
   CaseFile c = load("loads:\n  - group: top\n    value: 1\n  - group: bottom\n    value: x\n");
   CaseNode root = c.root();
