@@ -10,6 +10,10 @@ overlap's width (cases/dcb_coupled/README.md): error against run time.
         --set time.end=2.1e-3 --set "output.fields=[]" --out results/dcb_band_sweep
     PYTHONPATH=python python3 cases/dcb_coupled/band_sweep.py results/dcb_band_pure results/dcb_band_sweep
 
+The README's table sweeps following.yaml (the band that follows the crack) the same way, with
+--over coupling.overlap.band.half_thickness=3.5e-4,5.0e-4,4.0e-4 --with
+coupling.overlap.band.width=1.5e-4,2.0e-4,3.0e-4 and its own output.
+
 (time.end = 2.1 ms: the load lines have opened by Delta = 2.0 mm, the end of the comparison.)
 These sweep the case itself (40k DEs). Runs of the case made elsewhere (the validation tests'
 pure DEM and coupled DCB, which run to the case's 2.6 ms) may stand in for the pure run and be
@@ -115,8 +119,11 @@ def main(argv):
         raise SystemExit(__doc__)
     pure = arlequin.load(Path(argv[1]))
     sweep_dir = Path(argv[2])
-    runs = sorted(arlequin.load_sweep(sweep_dir) + [arlequin.load(Path(a)) for a in argv[3:]],
-                  key=lambda r: (r.summary["counts"]["particles"], label_of(r)))
+    loaded = arlequin.load_sweep(sweep_dir) + [arlequin.load(Path(a)) for a in argv[3:]]
+    # A run that failed (damage reaching the overlap stops one) has no whole curve to compare:
+    # it is listed below the table with its error, not left out silently.
+    failed = [r for r in loaded if r.summary.get("status") == "failed"]
+    runs = sorted((r for r in loaded if r not in failed), key=lambda r: (r.summary["counts"]["particles"], label_of(r)))
     until = min(r.series["time"].iloc[-1] for r in [pure] + runs)
     if pure.series["Delta"].max() < COMPARED[1] or until < pure.series["time"][pure.series["Delta"] <= COMPARED[1]].max():
         raise SystemExit(f"a run ends before Delta = {1e3 * COMPARED[1]:g} mm: run them to time.end = 2.1e-3 or later")
@@ -128,6 +135,8 @@ def main(argv):
         [r["run"], r["des"], r["continuum_dofs"], f"{r['wall_s']:.0f}", f"{rows[0]['wall_s'] / r['wall_s']:.2f}x",
          f"{100 * r['P_rel']:.2f} %", f"{100 * r['P_row_rel']:.2f} %", f"{100 * r['peak_rel']:+.2f} %",
          f"{100 * r['energy_rel']:+.2f} %", f"{100 * r['lefm_max_rel']:.2f} %"] for r in rows]))
+    for r in failed:
+        print(f"{label_of(r)}: failed at t = {1e3 * r.series['time'].iloc[-1]:.3g} ms: {r.summary.get('error', '')}")
     arlequin.write_table(sweep_dir / "band_sweep.csv", rows)
 
     arlequin.plot_error_against_time(sweep_dir / "band_sweep.png", rows[0], rows[1:],
