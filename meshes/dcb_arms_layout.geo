@@ -28,6 +28,12 @@ Transfinite Curve {Curve In BoundingBox{-e, -e, -e, L + e, e, 2 * h + e}} = nx; 
 Transfinite Curve {Curve In BoundingBox{-e, b - e, -e, L + e, b + e, 2 * h + e}} = nx;
 Transfinite Curve {Curve In BoundingBox{-e, -e, -e, e, b + e, 2 * h + e}} = nz;    // x = 0 face: z edges, then y edges
 Transfinite Curve {Curve In BoundingBox{L - e, -e, -e, L + e, b + e, 2 * h + e}} = nz;
+// nz_band, if set first: the node count through the two layers next to the mid-plane (z in
+// [h - t, h + t]), where a DEM band's overlap lies, instead of nz.
+If (Exists(nz_band))
+  Transfinite Curve {Curve In BoundingBox{-e, -e, 2 * t - e, e, b + e, 4 * t + e}} = nz_band;
+  Transfinite Curve {Curve In BoundingBox{L - e, -e, 2 * t - e, L + e, b + e, 4 * t + e}} = nz_band;
+EndIf
 For k In {0:6}
   Transfinite Curve {Curve In BoundingBox{-e, -e, k * t - e, e, b + e, k * t + e}} = ny;
   Transfinite Curve {Curve In BoundingBox{L - e, -e, k * t - e, L + e, b + e, k * t + e}} = ny;
