@@ -54,6 +54,16 @@ struct CaseRecord {
   }
 };
 
+// "file:line", or the file alone when the line is unknown (0).
+inline std::string file_line(const std::string& file, int line) {
+  return file + (line > 0 ? ":" + std::to_string(line) : "");
+}
+
+// "path.key", or the key alone at the top.
+inline std::string child_path(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+
 struct CaseState {
   std::filesystem::path file;    // as given by the user: messages show it like that
   std::filesystem::path folder;  // absolute; relative paths in the case are resolved here
@@ -85,14 +95,16 @@ struct CaseState {
                                               path[prefix.size()] == '['));
       if (covers && prefix.size() >= best_len) best = &o, best_len = prefix.size();
     }
-    const bool has_lines = !best || best->has_lines;
-    return (best ? best->where : file.string()) + (has_lines && line > 0 ? ":" + std::to_string(line) : "");
+    if (best && !best->has_lines) return best->where;
+    return file_line(best ? best->where : file.string(), line);
   }
 };
 
 }  // namespace detail
 
 using detail::CaseRecord;
+using detail::child_path;
+using detail::file_line;
 using Kind = CaseRecord::Kind;
 
 namespace {
@@ -276,7 +288,7 @@ std::vector<std::string> checked_keys(const YAML::Node& map, const std::string& 
     const int line = line_of(kv.first);
     if (!kv.first.IsScalar()) raise(where(path, line), path, "keys must be plain names");
     const std::string& key = kv.first.Scalar();
-    const std::string at = path.empty() ? key : path + "." + key;
+    const std::string at = child_path(path, key);
     const auto seen = std::find(keys.begin(), keys.end(), key);
     if (seen != keys.end())
       raise(where(at, line), at, "duplicate key (first given at line " + std::to_string(lines[seen - keys.begin()]) + ")");
@@ -285,8 +297,6 @@ std::vector<std::string> checked_keys(const YAML::Node& map, const std::string& 
   }
   return keys;
 }
-
-std::string file_line(const std::string& file, int line) { return file + (line > 0 ? ":" + std::to_string(line) : ""); }
 
 // The mapping `over` (a case that extends another, read from `file`) laid over `base`: mappings
 // present in both are merged key by key, any other value replaces the base's, and a key given
@@ -306,7 +316,7 @@ YAML::Node laid_over(detail::CaseState& s, const YAML::Node& base, const YAML::N
     placed[k] = true;
     if (!value.IsDefined() || value.IsNull()) return;  // removed
     out.force_insert(key_nodes[k], value);
-    s.origins.push_back({path.empty() ? keys[k] : path + "." + keys[k], file, true});
+    s.origins.push_back({child_path(path, keys[k]), file, true});
   };
   for (const auto& kv : base) {
     const auto k = static_cast<std::size_t>(std::find(keys.begin(), keys.end(), kv.first.Scalar()) - keys.begin());
@@ -314,7 +324,7 @@ YAML::Node laid_over(detail::CaseState& s, const YAML::Node& base, const YAML::N
       out.force_insert(kv.first, kv.second);
     } else if (const YAML::Node value = over[keys[k]]; value.IsMap() && kv.second.IsMap()) {
       placed[k] = true;
-      out.force_insert(kv.first, laid_over(s, kv.second, value, path.empty() ? keys[k] : path + "." + keys[k], file));
+      out.force_insert(kv.first, laid_over(s, kv.second, value, child_path(path, keys[k]), file));
     } else {
       put(k);
     }
@@ -507,7 +517,7 @@ std::string CaseNode::where() const { return state_->location(path_, line_); }
 std::string CaseNode::where(const Entry& e) const { return state_->location(e.path, e.line); }
 
 std::string CaseNode::key_path(std::string_view key) const {
-  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  return child_path(path_, key);
 }
 
 void CaseNode::fail(std::string_view key, std::string_view message) const { raise(where(key), key_path(key), message); }
