@@ -116,11 +116,12 @@ void ContinuumSolver::finish_setup() {
       FiniteStrainForce(points_.offset, points_.node, points_.grad, points_.material, stiffness, points_.basis, points_.coef);
 }
 
-void ContinuumSolver::set_weight(ScalarFunction alpha) {
+void ContinuumSolver::set_weight(ScalarFunction alpha, double mass_floor) {
   alpha_ = std::move(alpha);
   point_weight_.resize(points_.x.size());
   for (size_t q = 0; q < points_.x.size(); ++q) point_weight_[q] = alpha_(points_.x[q]) * points_.volume[q];
-  mass_ = weighted_lumped_mass(alpha_);
+  mass_ = mass_floor > 0.0 ? weighted_lumped_mass([this, mass_floor](const Vec3& x) { return std::max(alpha_(x), mass_floor); })
+                           : weighted_lumped_mass(alpha_);
   const Vec3& share = materials_.front().inertia;  // the same for every material (constructor)
   dof_mass_.resize(3 * mass_.size());
   for (std::size_t d = 0; d < dof_mass_.size(); ++d) dof_mass_[d] = mass_[d / 3] * share[static_cast<int>(d % 3)];

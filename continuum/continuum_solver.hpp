@@ -81,8 +81,11 @@ class ContinuumSolver {
   const std::vector<Vec3>& nodes() const { return mesh_.nodes(); }
   int num_nodes() const { return mesh_.num_nodes(); }
 
-  // Arlequin weight; recomputes the lumped mass and the point weights.
-  void set_weight(ScalarFunction alpha);
+  // Arlequin weight; recomputes the lumped mass and the point weights. The stiffness (point
+  // weights) takes alpha; the mass max(alpha, mass_floor), so that a node whose points all have
+  // alpha = 0 keeps a mass without the material gaining stiffness where it has no weight (the
+  // DEM's masses are floored alike, docs/decisions.md#d9).
+  void set_weight(ScalarFunction alpha, double mass_floor = 0.0);
   const std::vector<double>& lumped_mass() const { return mass_; }  // per node, weighted
   // Per dof: the node's lumped mass times the material's inertia share along the dof's axis;
   // the mass the dynamics use (kicks, kinetic energy, critical step, coupling).

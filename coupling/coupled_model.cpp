@@ -42,10 +42,9 @@ bool weight_models(dem::DemModel& dem, continuum::ContinuumSolver& continuum, co
   };
   if (first_massless_node() < 0) return false;
   // A node with alpha_c = 0 at all its mass points (e.g. a natural-neighbour node on the
-  // DEM-side edge of the overlap): ContinuumSolver weights mass and stiffness alike, so the only
-  // floor available is on both (a stiffness of eps times the material there).
-  const double eps = zone.mass_floor();
-  continuum.set_weight([zone, eps](const Vec3& x) { return std::max(zone.alpha_c(x), eps); });
+  // DEM-side edge of the overlap): its mass is floored as the DEs' are, max(alpha_c, eps), and
+  // its stiffness is not, which keeps the partition of unity of the energy (docs/decisions.md#d9).
+  continuum.set_weight([zone](const Vec3& x) { return zone.alpha_c(x); }, zone.mass_floor());
   if (const int n = first_massless_node(); n >= 0) {
     const Vec3& x = continuum.nodes()[n];
     std::ostringstream msg;
@@ -88,7 +87,7 @@ void CoupledModel::untie_prescribed_rows() {
 CoupledModel::CoupledModel(dem::DemModel& dem, continuum::ContinuumSolver& continuum, const OverlapZone& zone,
                            CoupledOptions options)
     : dem_(dem), continuum_(continuum), zone_(zone), options_(std::move(options)) {
-  continuum_stiffness_floored_ = weight_models(dem_, continuum_, zone_);
+  continuum_mass_floored_ = weight_models(dem_, continuum_, zone_);
   dem_.finalize();
   if (options_.hold_overlap_failures) {  // after finalize, which orders the bonds
     const auto& reference = dem_.particles.reference;
@@ -400,7 +399,7 @@ std::string CoupledModel::summary() const {
   const auto& w = zone_.weighting();
   s << "coupling overlap: " << zone_.description() << "\n"
     << "coupling weights: " << weight_shape_name(w.shape) << ", mass floor " << w.mass_floor;
-  if (continuum_stiffness_floored_) s << " (continuum: on mass and stiffness, some nodes had alpha_c = 0)";
+  if (continuum_mass_floored_) s << " (continuum: on mass too, some nodes had alpha_c = 0)";
   s << "\n"
     << "coupling operators: mediator " << mediator_name(ops_.settings.mediator) << ", "
     << coupling_type_name(ops_.settings.type);

@@ -12,9 +12,9 @@
 //    both at rest, or both on one affine field); displacement_residual() reports it.
 //  - Weights are evaluated in the reference configuration. If some continuum node has no weighted
 //    mass (alpha_c = 0 at all its mass points, e.g. natural-neighbour nodes on the DEM-side edge
-//    of the overlap), the continuum weight becomes max(alpha_c, eps) for mass AND stiffness, as
-//    ContinuumSolver::set_weight has one weight for both; summary() says so. DEs beyond the
-//    overlap on the continuum side must not exist.
+//    of the overlap), the continuum's mass weight becomes max(alpha_c, eps), as the DEs' is; its
+//    stiffness keeps alpha_c (no stiffness where the DEM alone carries the load); summary() says
+//    so. DEs beyond the overlap on the continuum side must not exist.
 //  - Consistent overlap quadrature (options.consistent_quadrature; "coupling.quadrature:
 //    consistent"). Under a uniform stress sigma carried by both models, the gradient of the
 //    weighted bond energy at DE p is r_d = -sigma h_p, h_p = sum over its Laguerre faces f of
@@ -292,7 +292,7 @@ class CoupledModel {
   Matrix3 vd_, vd_drift_, vc_drift_, lambda_;
   MultiplierSolver::Impulse constraint_force_next_;
   TimeSteps time_steps_;
-  bool continuum_stiffness_floored_ = false;
+  bool continuum_mass_floored_ = false;
   int prescribed_rows_ = 0;  // rows untied by untie_prescribed_rows
   continuum::ContinuumSolver::WeightCorrection quadrature_correction_;
   double coupling_work_ = 0.0;
