@@ -325,9 +325,6 @@ TEST(FabricCoupled, AYarnPulseLeavesThroughTheOverlapIntoThePlate) {
   EXPECT_GT(coarse_R, 0.2);
 }
 
-// The issue's bounds on a comparison of the coupled target with the pure DEM (compare.json, and
-// the first break's relative difference, a pair's or the ensemble's median): the sphere's velocity
-// history within 5 % (max relative), the peak impact force within 10 %, the first break within 10 %.
 // The entry of sensor `name` in a compare report; it must be there exactly once (else the test
 // fails, and reading the empty entry throws).
 Json sensor_entry(const Json& report, const std::string& name) {
@@ -339,6 +336,9 @@ Json sensor_entry(const Json& report, const std::string& name) {
   return found;
 }
 
+// The issue's bounds on a comparison of the coupled target with the pure DEM (compare.json, and
+// the first break's relative difference, a pair's or the ensemble's median): the sphere's velocity
+// history within 5 % (max relative), the peak impact force within 10 %, the first break within 10 %.
 void expect_within_the_issues_bounds(const Json& report, double first_break, const std::string& label) {
   EXPECT_LT(sensor_entry(report, "sphere_velocity").at("max_relative_difference").get<double>(), 0.05) << label;
   EXPECT_LT(std::abs(sensor_entry(report, "impact_force").at("peak_relative_difference").get<double>()), 0.10) << label;
