@@ -509,13 +509,11 @@ std::optional<OverlapDamage> CoupledModel::damage_in_overlap() {
 
 void CoupledModel::solve_and_correct(double dt) {
   gather_dem_velocity(vd_);
-  solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_, &constraint_force_next_);
+  // The corrections and multipliers of the half step dt/2, per unit time: acc_d_, acc_c_, mu(n+1)
+  // and the constraint forces.
+  solver_->project(vd_, continuum_velocity(), acc_d_, acc_c_, lambda_, &constraint_force_next_, 2.0 / dt);
   scatter_dem_velocity(vd_);
-  const double inv_h = 2.0 / dt;  // the corrections and multipliers of the half step dt/2, per unit time
   const std::vector<int>& nodes = solver_->corrected_nodes();
-  acc_d_ *= inv_h;
-  constraint_force_next_.dem *= inv_h;
-  lambda_ *= inv_h;  // now mu(n+1)
   // Work of F = -G^T mu over the drift, trapezoidal in time: -dt (mu(n) + mu(n+1))/2 . G v(n+1/2),
   // as G^T (mu(n) + mu(n+1)) . v(n+1/2) over the coupled DEs and the nodes G reaches.
   double power = (constraint_force_.dem + constraint_force_next_.dem).cwiseProduct(vd_drift_).sum();
@@ -523,11 +521,7 @@ void CoupledModel::solve_and_correct(double dt) {
   const Matrix3& fc_before = constraint_force_.continuum;
   for (std::size_t k = 0; k < nodes.size(); ++k) {  // 0 elsewhere (MultiplierSolver::project)
     const int n = nodes[k];
-    for (int c = 0; c < 3; ++c) {
-      acc_c_(n, c) *= inv_h;
-      fc(n, c) *= inv_h;
-      power += (fc_before(n, c) + fc(n, c)) * vc_drift_(static_cast<Eigen::Index>(k), c);
-    }
+    for (int c = 0; c < 3; ++c) power += (fc_before(n, c) + fc(n, c)) * vc_drift_(static_cast<Eigen::Index>(k), c);
   }
   coupling_work_ -= 0.5 * dt * power;
   mu_.swap(lambda_);

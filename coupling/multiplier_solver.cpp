@@ -577,7 +577,7 @@ void MultiplierSolver::residual(const Matrix3& vd, const Eigen::Ref<const Matrix
 }
 
 void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc,
-                                        Matrix3& lambda, Impulse* impulse) const {
+                                        Matrix3& lambda, Impulse* impulse, double rate) const {
   const long rows = ops_->rows(), k = a.U.cols();
   const bool rows_threaded = rows > parallel_threshold_rows;
   // h, the held dofs' share of G_c vc (the other components of their nodes are U's).
@@ -604,8 +604,10 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
   });
   solve_systems(a.K, w_, w_, nullptr);
   // The tied components meet their rows, W vd' + U v_c' + h = 0; the others keep their velocity.
+  // One pass over the rows also gives the impulse G_d^T lambda = g lambda and the rate.
   lambda.resize(rows, 3);
   dd.resize(rows, 3);
+  if (impulse) impulse->dem.resize(rows, 3);
   const int* outer = a.U.outerIndexPtr();
   const int* column = a.U.innerIndexPtr();
   const double* value = a.U.valuePtr();
@@ -614,47 +616,46 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
     for (int e = outer[r]; e < outer[r + 1]; ++e)
       for (int c = 0; c < 3; ++c) uv[c] += value[e] * w_(column[e], c);
     for (int c = 0; c < 3; ++c) {
-      if (a.tied(r, c) == 0.0) {
-        dd(r, c) = lambda(r, c) = 0.0;
-        continue;
+      double correction = 0.0, multiplier = 0.0;
+      if (a.tied(r, c) != 0.0) {
+        const double projected = -(uv[c] + held_share(r, c)) * a.inv_g[r];
+        correction = vd(r, c) - projected;
+        multiplier = correction * a.mass_over_g[r];
+        vd(r, c) = projected;
       }
-      const double projected = -(uv[c] + held_share(r, c)) * a.inv_g[r];
-      dd(r, c) = vd(r, c) - projected;
-      lambda(r, c) = dd(r, c) * a.mass_over_g[r];
-      vd(r, c) = projected;
+      dd(r, c) = correction * rate;
+      lambda(r, c) = multiplier * rate;
+      if (impulse) impulse->dem(r, c) = a.g[r] * multiplier * rate;
     }
   });
+  Matrix3* fc = impulse ? &impulse->continuum : nullptr;
+  if (fc && fc->rows() != GcT_.rows()) fc->setZero(GcT_.rows(), 3);
   for_each_index(k, k > parallel_threshold_rows, [&](long j) {
     const int n = a.node[static_cast<std::size_t>(j)];
     for (int c = 0; c < 3; ++c)
       if (a.movable(j, c) != 0.0) {
-        dc(n, c) = vc(n, c) - w_(j, c);
+        const double correction = vc(n, c) - w_(j, c);
         vc(n, c) = w_(j, c);
+        dc(n, c) = correction * rate;
+        if (fc) (*fc)(n, c) = a.mass(j, c) * correction * rate;  // C^-1 dc = G_c^T lambda where the node moves
+      } else if (fc) {
+        (*fc)(n, c) = 0.0;
       }
   });
-  if (!impulse) return;
-  impulse->dem.resize(rows, 3);
-  for_each_index(rows, rows_threaded, [&](long r) { impulse->dem.row(r) = a.g[r] * lambda.row(r); });
-  Matrix3& fc = impulse->continuum;
-  if (fc.rows() != GcT_.rows()) fc.setZero(GcT_.rows(), 3);
-  for_each_index(k, k > parallel_threshold_rows, [&](long j) {  // C^-1 dc = G_c^T lambda where the node moves
-    const int n = a.node[static_cast<std::size_t>(j)];
-    for (int c = 0; c < 3; ++c) fc(n, c) = a.mass(j, c) * dc(n, c);
-  });
-  if (!any_held) return;
+  if (!fc || !any_held) return;
   for (int n = 0; n < a.heldT.outerSize(); ++n) {  // and the held components' from their entries
     double sum[3] = {0.0, 0.0, 0.0};
     for (RowMajorMatrix::InnerIterator it(a.heldT, n); it; ++it)
       for (int c = 0; c < 3; ++c) sum[c] += it.value() * lambda(it.col(), c);
     for (int c = 0; c < 3; ++c)
-      if (inv_c_(n, c) == 0.0) fc(n, c) = sum[c];
+      if (inv_c_(n, c) == 0.0) (*fc)(n, c) = sum[c];
   }
 }
 
 void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda,
-                               Impulse* impulse) const {
+                               Impulse* impulse, double rate) const {
   if (dc.rows() != GcT_.rows()) dc.setZero(GcT_.rows(), 3);
-  if (low_rank_) return project_low_rank(*low_rank_, vd, vc, dd, dc, lambda, impulse);
+  if (low_rank_) return project_low_rank(*low_rank_, vd, vc, dd, dc, lambda, impulse, rate);
   residual(vd, vc, rhs_);
   solve(rhs_, lambda);
   const long rows = GdT_.rows(), nodes = static_cast<long>(corrected_nodes_.size());
@@ -675,6 +676,13 @@ void MultiplierSolver::project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd,
     const int n = corrected_nodes_[static_cast<std::size_t>(k)];
     vc.row(n) -= dc.row(n);
   });
+  if (rate == 1.0) return;
+  dd *= rate;
+  lambda *= rate;
+  for (int n : corrected_nodes_) dc.row(n) *= rate;
+  if (!impulse) return;
+  impulse->dem *= rate;
+  for (int n : corrected_nodes_) impulse->continuum.row(n) *= rate;
 }
 
 }  // namespace arlequin::coupling

@@ -88,12 +88,17 @@ class MultiplierSolver {
   // caller that keeps dc between calls (and changes it only on corrected_nodes()) reads the
   // whole correction in it. With `impulse`, also the multipliers' impulses G_d^T lambda (DEs x 3)
   // and G_c^T lambda (nodes x 3, set to 0 when resized and written on corrected_nodes() only),
-  // held DEs and dofs included: what the work of the multiplier forces needs.
+  // held DEs and dofs included: what the work of the multiplier forces needs. dd, dc, lambda and
+  // the impulses come multiplied by `rate` (a step's half kick passes 2/dt and gets them per unit
+  // time: accelerations, multipliers, forces); vd and vc are the projected velocities whatever it
+  // is. The Woodbury form scales each entry as it computes it, in the same pass (the same bits as
+  // scaling afterwards but for the impulse on a held continuum component: a sum of scaled
+  // multipliers).
   struct Impulse {
     Matrix3 dem, continuum;
   };
   void project(Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc, Matrix3& lambda,
-               Impulse* impulse = nullptr) const;
+               Impulse* impulse = nullptr, double rate = 1.0) const;
   // The continuum nodes a projection can correct (those G_c reaches), in increasing order.
   const std::vector<int>& corrected_nodes() const { return corrected_nodes_; }
 
@@ -152,7 +157,7 @@ class MultiplierSolver {
   void solve_low_rank(const LowRank& a, const Matrix3& rhs, Matrix3& lambda) const;
   // project() in the low-rank form, from the velocities (the header's direct form).
   void project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Ref<Matrix3> vc, Matrix3& dd, Matrix3& dc,
-                        Matrix3& lambda, Impulse* impulse) const;
+                        Matrix3& lambda, Impulse* impulse, double rate) const;
   // out = A_s^-1 in in the components each system s serves, A_s = factors[s], every system at
   // once (the tasks of all of them on the threads); with `scales`, A_s is the scaled S A S and
   // in and out are scaled by S (scales[s] per row). out may be in.

@@ -210,6 +210,35 @@ TEST(CouplingMultiplierSolver, TheImpulsesAreGTransposedLambdaWithTheHeldDofs) {
   }
 }
 
+// A rate scales what a projection returns, not what it projects: the projected velocities are
+// the same to the bit, the corrections, multipliers and the DEs' impulses are rate times those
+// of rate 1 to the bit (each scaled once computed), and the nodes' impulses to round-off (a held
+// dof's is a sum of the scaled multipliers), in the Woodbury form and the general factor.
+TEST(CouplingMultiplierSolver, ARateScalesTheCorrectionsMultipliersAndImpulsesOnly) {
+  const auto [fine, md, mc] = shared_nodes();
+  CouplingOperators general = fine;
+  general.settings.mediator = Mediator::coarse;
+  const MultiplierSolver woodbury(fine, md, mc, std::nullopt), factor(general, md, mc, std::nullopt);
+  const double rate = 2.0 / 3.1e-9;  // a half step's 2/dt
+  for (const MultiplierSolver* solver : {&woodbury, &factor}) {
+    Matrix3 vd, vc;
+    mixed_velocities(fine.num_particles(), fine.Gc.cols(), 0.03, 0.1, vd, vc);
+    Matrix3 vd1 = vd, vc1 = vc, vdr = vd, vcr = vc, dd1, dc1, lambda1, ddr, dcr, lambdar;
+    MultiplierSolver::Impulse impulse1, impulser;
+    solver->project(vd1, vc1, dd1, dc1, lambda1, &impulse1);
+    solver->project(vdr, vcr, ddr, dcr, lambdar, &impulser, rate);
+    const std::string name = solver->backend().substr(0, 5);
+    EXPECT_EQ(vdr, vd1) << name;
+    EXPECT_EQ(vcr, vc1) << name;
+    EXPECT_GT(dd1.norm(), 1e-3 * vd.norm()) << name;  // there is a correction to scale
+    EXPECT_EQ(ddr, Matrix3(rate * dd1)) << name;
+    EXPECT_EQ(dcr, Matrix3(rate * dc1)) << name;
+    EXPECT_EQ(lambdar, Matrix3(rate * lambda1)) << name;
+    EXPECT_EQ(impulser.dem, Matrix3(rate * impulse1.dem)) << name;
+    EXPECT_LT((impulser.continuum - rate * impulse1.continuum).norm(), 1e-15 * rate * impulse1.continuum.norm()) << name;
+  }
+}
+
 // Two bodies coupled apart (the DCB's two arms): K falls into two blocks, its factor's
 // elimination forest into two trees of 1500 columns, and the Woodbury form solves them as two
 // independent parts, on the threads. The multipliers are the general factor's to round-off, G v
