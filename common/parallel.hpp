@@ -18,7 +18,7 @@ inline constexpr long parallel_threshold = 4096;
 // components, or a factor's row, gathered and scattered through an index list or a permutation;
 // its sparse products keep parallel_threshold, on their entries): a row costs several times a
 // plain per-DE update, so a loop of a thousand rows already takes several times what entering a
-// parallel region costs (bench_omp_regions). The coupled fabric's 2 368 coupled DEs and the
+// parallel region costs (bench_omp_regions). The coupled fabric's 2 502 coupled DEs and the
 // following DCB band's ~3 000 lie between the two bounds (docs/performance.md#coupling-rows).
 inline constexpr long parallel_threshold_rows = 1024;
 // The same for bonds, per colour of a bond set on average (dem::BondColouring). A bond costs

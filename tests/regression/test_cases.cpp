@@ -1007,7 +1007,7 @@ TEST(Cases, WholeRunsAreBitIdenticalOnOneAndTwoThreads) {
                            "{box: [[-1, -1, -1], [1, 1, 1]]}}]\" --set \"sensors=[{name: E_dem_side, type: energy, group: dem_only}]\"",
        true},
       // The finite-strain P1 plate (its tiles and gather on threads), the low-rank multipliers
-      // (the coupling's loops over its 2 368 coupled DEs' rows on threads, above
+      // (the coupling's loops over its 2 502 coupled DEs' rows on threads, above
       // parallel_threshold_rows), weighted contacts, to just past the first breaks (30 us).
       {"fabric_impact_coupled", "fabric_impact_coupled/case.yaml --set time.end=3.2e-5", true},
       // The coupled DCB at 40k: the coupling's per-DE and per-node loops (5142 coupled DEs, above
