@@ -388,25 +388,31 @@ TEST(ValidationFabric, CoupledSeedTargetMatchesThePureDem) {
   }
 }
 
-// Validation: the 44 x 100 mm target, run once in pure DEM (143 944 DEs, about a minute on two
-// threads) and coupled (large.yaml: the cross of DEM along the principal yarns, 39 780 DEs). One
-// comparison is one draw (d43); the issue's bounds on it: the sphere's velocity within 5 %
-// (measured 0.961 %; 20.4 % with the 16 mm core alone), the peak force within 10 % (measured
-// +3.45 %), the first break within 10 % (measured -0.307 %; with a 14 mm core in the cross,
-// -13.8 %), and the coupled balance with the fracture energy within 1 % of the impact
-// energy (measured 2.7e-4). Its speed-up (2.73x) is the README's, not asserted.
+// Validation: the 44 x 100 mm target in pure DEM (143 944 DEs, about a minute on two threads)
+// and coupled (large.yaml: the cross of DEM along the principal yarns, 39 780 DEs). One comparison
+// is one draw (d43): pair 0 alone met the issue's bounds on an Intel Xeon VM (0.961 %, +3.45 %,
+// -0.307 %) and failed them on an AMD EPYC VM (5.56 %, -6.13 %, first break -13.9 %), the pure
+// run's first break the same on both. So, as for the seed target, the bounds are asserted on the medians
+// of seven pairs (`compare --ensemble 7`, d44; about 11 minutes): the sphere's velocity within 5 %
+// (measured 2.75 % on the AMD VM, the pairs 0.817 to 5.65 %, the pure run against itself up to
+// 7.33 %; 20.4 % with the 16 mm core alone, one draw), the peak force within 10 % (measured
+// +3.62 %), the first break within 10 % (measured -0.783 %, the pairs -13.9 to +15.6 %, the pure
+// run's own spread up to 16.8 %), and pair 0's coupled balance with the fracture energy within 1 %
+// of the impact energy (measured 2.7e-4). Its speed-up is the README's, not asserted.
 TEST(ValidationFabric, LargerTargetMatchesThePureDem) {
 #ifndef ARLEQUIN_WITH_CONTINUUM
   GTEST_SKIP() << "built without the continuum";
 #endif
   const auto out = test::scratch_dir("fabric_compare_large");
   const std::string pure = std::string(ARLEQUIN_SOURCE_DIR) + "/cases/fabric_impact/large.yaml";
-  const auto r = test::run_arlequin("compare " + pure + " " + coupled_dir + "large.yaml --set output.fields=[] --out " + out.string());
+  const auto r = test::run_arlequin("compare " + pure + " " + coupled_dir + "large.yaml --ensemble 7 --set output.fields=[] --out " +
+                                    out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json report = Json::parse(test::read_text(out / "compare.json"));
+  ASSERT_EQ(report.at("ensemble").at("pairs").get<int>(), 7);
   EXPECT_TRUE(report.at("reference").at("completed").get<bool>());
   EXPECT_TRUE(report.at("other").at("completed").get<bool>());
-  expect_within_the_issues_bounds(report, report.at("first_break_relative_difference").get<double>(), "large");
+  expect_within_the_issues_bounds(report, report.at("ensemble").at("first_break_relative_difference").get<double>(), "large");
   EXPECT_LT(worst_balance(test::read_csv(out / "other" / "series.csv")), 0.01 * impact_energy());
 }
 
