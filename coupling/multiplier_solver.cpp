@@ -604,7 +604,7 @@ void MultiplierSolver::project_low_rank(const LowRank& a, Matrix3& vd, Eigen::Re
   });
   solve_systems(a.K, w_, w_, nullptr);
   // The tied components meet their rows, W vd' + U v_c' + h = 0; the others keep their velocity.
-  // One pass over the rows also gives the impulse G_d^T lambda = g lambda and the rate.
+  // The same pass scales by the rate and gives the impulse G_d^T lambda = g lambda.
   lambda.resize(rows, 3);
   dd.resize(rows, 3);
   if (impulse) impulse->dem.resize(rows, 3);
