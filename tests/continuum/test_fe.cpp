@@ -103,6 +103,15 @@ TEST(ContinuumFe, WeightedLumpedMassIntegratesAlphaRho) {
     m = 0;
     for (double mi : s->lumped_mass()) m += mi;
     EXPECT_NEAR(m, 1.0, 1e-12);
+    if (order == 1) {
+      // P1's masses are row sums, m_I = int alpha rho N_I; with sum_I N_I x_I = x the first
+      // moment sum_I m_I x_I is int rho x^2 = 2/3 (the degree-2 rule is exact for a linear alpha).
+      // Equal shares of each element's int alpha rho would give the elements' centroids instead.
+      const auto& masses = s->lumped_mass();
+      double moment = 0;
+      for (int n = 0; n < s->num_nodes(); ++n) moment += masses[static_cast<std::size_t>(n)] * s->nodes()[n].x;
+      EXPECT_NEAR(moment, 2.0 / 3.0, 1e-12);
+    }
     // The weight also scales the strain energy: alpha = 1/2 halves it.
     for (int n = 0; n < s->num_nodes(); ++n) s->displacement()[3 * n] = 1e-3 * s->nodes()[n].x;
     s->set_weight([](const Vec3&) { return 1.0; });

@@ -4,7 +4,8 @@
 // Benzeggagh-Kenane toughness along a fixed mixed path, the energy dissipated per unit area at
 // failure (G_I, G_II, G_c(B)) to 1e-6, unloading and reloading on the damaged stiffness, no
 // energy created over a load-unload cycle, compression as a penalty contact, no opening from a
-// rigid rotation of the pair, and a pre-cracked link that carries nothing.
+// rigid rotation of the pair, and a pre-cracked link that carries nothing. Also the crack's tip,
+// damage front and dissipated energy measured on a row of links opened by known amounts.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -15,6 +16,7 @@
 
 #include "common/quat.hpp"
 #include "dem/bonds/cohesive_contact.hpp"
+#include "dem/crack_front.hpp"
 
 namespace arlequin::dem {
 namespace {
@@ -357,6 +359,41 @@ TEST(CohesiveArea, TheLinksCoverTheirLatticeCells) {
               return Vec3{x, r * std::sin(a), r * std::cos(a)};
             }),
             0.0);
+}
+
+// A row of ten links along x (DEs of radius 1 at x = 2k, z = 0 and z = 2), each opened along z
+// by its own u_k in one pass: three beyond u_f (failed), then 5e-4, 1e-4 and 1.5e-5 m (damage
+// 0.99, 0.91 and 0.34 by d = u_f (u - u_0) / (u (u_f - u_0))), then 5e-6 m, below u_0 (none).
+// The tip is the last failed link (x = 4), the damage front the last damaged one (x = 10); the
+// energy dissipated is G_I S (u_k - u_0) / (u_f - u_0) a link, G_I S once failed (the bilinear
+// law's area up to the largest opening).
+TEST(CrackFront, TipIsTheLastFailedLinkAndTheFrontTheLastDamagedOne) {
+  const double openings[10] = {2e-3, 2e-3, 2e-3, 5e-4, 1e-4, 1.5e-5, 5e-6, 5e-6, 5e-6, 5e-6};
+  ParticleSet p;
+  CohesiveContactSet::Parameters q;
+  q.strength_normal = q.strength_shear = sigma_n;
+  q.toughness_I = q.toughness_II = G_I;
+  q.stiffness = k;
+  CohesiveContactSet row(q);
+  for (int i = 0; i < 10; ++i) {
+    p.add({2.0 * i, 0, 0}, 1.0, 1.0);
+    p.add({2.0 * i, 0, 2.0}, 1.0, 1.0);
+    row.add(2 * i, 2 * i + 1, p);
+  }
+  row.finalize(p.size());
+  double expected = 0.0;
+  for (int i = 0; i < 10; ++i) {
+    p.position[2 * i + 1].z += openings[i];
+    expected += G_I * S * std::clamp((openings[i] - dn0) / (dnf - dn0), 0.0, 1.0);
+  }
+  p.clear_forces();
+  row.accumulate_forces(p, criterion_scan());
+  EXPECT_NEAR(row.damage_values()[4], 0.909, 1e-3);  // the case is the one described
+  EXPECT_NEAR(row.damage_values()[5], 0.337, 1e-3);
+  const CrackFront crack = measure_crack(row, p, {1, 0, 0}, {0, 1, 0}, 1);
+  EXPECT_DOUBLE_EQ(crack.tip, 4.0);
+  EXPECT_DOUBLE_EQ(crack.damage_front, 10.0);
+  EXPECT_NEAR(crack.dissipated, expected, 1e-9 * expected);
 }
 
 }  // namespace

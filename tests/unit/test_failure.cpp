@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Bond failure against closed forms: BBF thresholds in pure tension and pure bending, springs at
 // their maximum elongation, no force after a break, the RDEF virial stress of a uniformly
-// strained lattice, RDEF breaking every bond of a DE, and contact between former partners.
+// strained lattice, the largest principal and von Mises stresses of rotated principal values,
+// RDEF breaking every bond of a DE, its average weighted by the DEs' volumes, and contact
+// between former partners.
 // Also: RDEF's shortcut threshold test against the full eigenvalue, the force pass that
 // records the failure measures and energies giving the same bits on 1 and 2 threads, and the
 // output rows' energies read from that record.
@@ -127,6 +129,48 @@ TEST(VirialStress, EqualsTheAppliedStressInAUniformlyStrainedLattice) {
   // Uniaxial: von Mises equals the axial stress, the hydrostatic stress a third of it.
   EXPECT_NEAR(equivalent_stress(sigma[centre], RdefEquivalent::von_mises), sigma[centre][0], 1e-9 * applied);
   EXPECT_NEAR(equivalent_stress(sigma[centre], RdefEquivalent::hydrostatic), sigma[centre][0] / 3.0, 1e-9 * applied);
+}
+
+// The largest principal stress and the von Mises stress of R diag(s1, s2, s3) R^T are those of
+// diag(s1, s2, s3): max(s1, s2, s3) and sqrt(((s1 - s2)^2 + (s2 - s3)^2 + (s3 - s1)^2) / 2)
+// (invariance under rotation), over random rotations and principal values, distinct, two equal
+// and all three equal. A pure shear tau gives tau and sqrt(3) tau. Bounds, relative to the
+// largest |s|, about ten times the errors measured (5.8e-14, 1.3e-8, 2.7e-15): the largest
+// eigenvalue 1e-12 where the three differ, 1e-7 where two meet (the cosine form loses digits
+// there: acos near +-1, an error of about sqrt(ulp)); von Mises, a root of a sum of squares, 3e-14.
+TEST(EquivalentStress, PrincipalAndVonMisesAreThoseOfTheRotatedPrincipalValues) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  double worst_principal[2] = {0.0, 0.0}, worst_mises = 0.0;  // [two or three equal]
+  for (int n = 0; n < 3000; ++n) {
+    std::array<double, 3> s{uni(rng), uni(rng), uni(rng)};
+    const bool meet = n % 3 == 1 || n % 30 == 2;
+    if (n % 3 == 1) s[2] = s[n % 2];
+    if (n % 30 == 2) s[1] = s[2] = s[0];
+    const Quat q = from_rotation_vector(Vec3{uni(rng), uni(rng), uni(rng)} * 3.0);
+    const Vec3 e[3] = {rotate(q, Vec3{1, 0, 0}), rotate(q, Vec3{0, 1, 0}), rotate(q, Vec3{0, 0, 1})};
+    Sym3 t{};  // sum_k s_k e_k (x) e_k, Voigt order xx, yy, zz, yz, xz, xy
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& a = e[k];
+      const Sym3 ek{a.x * a.x, a.y * a.y, a.z * a.z, a.y * a.z, a.x * a.z, a.x * a.y};
+      for (int c = 0; c < 6; ++c) t[c] += s[k] * ek[c];
+    }
+    const double scale = std::max({std::abs(s[0]), std::abs(s[1]), std::abs(s[2])});
+    const double mises = std::sqrt(0.5 * ((s[0] - s[1]) * (s[0] - s[1]) + (s[1] - s[2]) * (s[1] - s[2]) + (s[2] - s[0]) * (s[2] - s[0])));
+    double& worst = worst_principal[meet];
+    worst = std::max(worst, std::abs(max_principal(t) - std::max({s[0], s[1], s[2]})) / scale);
+    worst_mises = std::max(worst_mises, std::abs(von_mises(t) - mises) / scale);
+  }
+  EXPECT_LT(worst_principal[0], 1e-12);
+  EXPECT_LT(worst_principal[1], 1e-7);
+  EXPECT_LT(worst_mises, 3e-14);
+  const double tau = 3.0;
+  for (int c = 3; c < 6; ++c) {
+    Sym3 shear{};
+    shear[c] = tau;
+    EXPECT_NEAR(max_principal(shear), tau, 1e-15 * tau);
+    EXPECT_NEAR(von_mises(shear), std::sqrt(3.0) * tau, 1e-15 * tau);
+  }
 }
 
 // The threshold test of RDEF decides as equivalent_stress does, bit for bit, with or without
@@ -636,6 +680,51 @@ TEST(Rdef, AverageLeavesOutPartnersOfAnotherThresholdGroup) {
   model.step(1e-12);
   ASSERT_EQ(model.breaks().size(), 2u);
   EXPECT_EQ(model.damage()[2], 1.0);
+}
+
+// The average weighs each DE's stress by its volume: sum Omega sigma / sum Omega. A chain of
+// unequal DEs (radii 1, 0.8, 1.5, 0.9, 1 mm, volumes 4/3 pi R^3 / compaction), its two middle
+// bonds stretched; the averages are computed here from the per-DE stresses, and a threshold 1 %
+// under the largest breaks that DE's bonds only, 1 % over it none.
+TEST(Rdef, AverageWeighsEachStressByItsVolume) {
+  const double radii[5] = {1e-3, 0.8e-3, 1.5e-3, 0.9e-3, 1e-3}, compaction = 0.63;
+  const auto run = [&](double threshold_factor, std::size_t* highest) {
+    auto model = std::make_unique<DemModel>();
+    double x = 0.0;
+    for (int i = 0; i < 5; ++i) {
+      if (i > 0) x += radii[i - 1] + radii[i];
+      model->particles.add({x, 0, 0}, radii[i], 7800.0);
+    }
+    test::bond_all_touching(*model, {2e11, 0.3, 0.5});
+    for (std::size_t i : {0u, 1u}) model->particles.position[i].x -= 1e-6;
+    for (std::size_t i : {3u, 4u}) model->particles.position[i].x += 1e-6;
+    const auto sigma = model->virial_stress(compaction);
+    std::vector<double> omega(5), average(5);
+    for (int i = 0; i < 5; ++i) omega[i] = 4.0 / 3.0 * std::numbers::pi * std::pow(radii[i], 3) / compaction;
+    for (int i = 0; i < 5; ++i) {
+      double weighted = 0.0, volume = 0.0;
+      for (int j = std::max(0, i - 1); j <= std::min(4, i + 1); ++j) weighted += omega[j] * sigma[j][0], volume += omega[j];
+      average[i] = weighted / volume;
+    }
+    *highest = static_cast<std::size_t>(std::max_element(average.begin(), average.end()) - average.begin());
+    std::vector<double> others = average;
+    others.erase(others.begin() + static_cast<long>(*highest));
+    EXPECT_LT(*std::max_element(others.begin(), others.end()), 0.97 * average[*highest]);
+    DemModel::RdefSettings settings{threshold_factor * average[*highest], RdefEquivalent::max_principal, compaction, {}};
+    settings.average = RdefAverage::bonded_neighbours;
+    model->enable_rdef(settings);
+    model->finalize();
+    model->step(1e-12);
+    return model;
+  };
+  std::size_t highest = 0;
+  const auto below = run(0.99, &highest);
+  ASSERT_EQ(below->breaks().size(), 2u);
+  for (const auto& e : below->breaks()) {
+    const auto& set = *below->bond_sets()[e.set];
+    EXPECT_TRUE(set.first()[e.bond] == highest || set.second()[e.bond] == highest);
+  }
+  EXPECT_TRUE(run(1.01, &highest)->breaks().empty());
 }
 
 // Two DEs bonded by a weak beam are pulled apart until it breaks; sent back towards each other,

@@ -1,14 +1,19 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Verification of the explicit step against closed forms: free flight and spin, a bonded
 // pair's axial frequency, energy drift and momentum conservation of a bonded block, the
-// long-wave speed of a bonded chain, and an elastic head-on contact.
+// long-wave speed of a bonded chain, and an elastic head-on contact; the critical step's bound
+// against a bonded pair's eigenvalues.
 #include <gtest/gtest.h>
+
+#include <Eigen/Dense>
 
 #include <cmath>
 #include <random>
 
 #include "common/error.hpp"
 #include "common/parallel.hpp"
+#include "dem/bonds/cohesive_contact.hpp"
+#include "dem/bonds/spring_bond.hpp"
 #include "dem/contacts/penalty_contact.hpp"
 #include "support/dem_fixtures.hpp"
 #include "support/omp_threads.hpp"
@@ -422,6 +427,101 @@ TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
   EXPECT_LE(model.critical_time_step(), 2.0 / omega_axial);
   // A bound, not a wild one: within a factor of four of the axial mode's limit.
   EXPECT_GT(model.critical_time_step(), 0.25 * 2.0 / omega_axial);
+}
+
+// The highest natural frequency of the model's DEs and bonds, linearised about their present
+// state, computed apart from the bound critical_time_step() takes: the stiffness K by central
+// differences of the bonds' forces and torques (moves of 1e-7 of a radius, turns of 1e-7 rad
+// about the global axes, to which the torques are conjugate), M = diag(m, m, m, I, I, I) per
+// DE, and omega_max^2 the largest eigenvalue of M^-1/2 K M^-1/2.
+double highest_frequency(const DemModel& model) {
+  ParticleSet p = model.particles;
+  const int n = 6 * static_cast<int>(p.size());
+  const auto actions = [&] {
+    p.clear_forces();
+    for (const auto& set : model.bond_sets()) set->accumulate_forces(p, ForceScan{});
+    Eigen::VectorXd a(n);
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (int c = 0; c < 3; ++c) a(6 * i + c) = p.force[i][c], a(6 * i + 3 + c) = p.torque[i][c];
+    return a;
+  };
+  Eigen::MatrixXd K(n, n);
+  for (int d = 0; d < n; ++d) {
+    const std::size_t i = static_cast<std::size_t>(d / 6);
+    const int c = d % 6;
+    const double h = c < 3 ? 1e-7 * p.radius[i] : 1e-7;
+    const ParticleSet start = p;
+    const auto moved = [&](double by) {
+      p = start;
+      Vec3 e{};
+      e[c % 3] = by;
+      if (c < 3) p.position[i] += e;
+      else p.orientation[i] = from_rotation_vector(e) * p.orientation[i];
+      return actions();
+    };
+    K.col(d) = (moved(-h) - moved(h)) / (2.0 * h);
+    p = start;
+  }
+  EXPECT_LT((K - K.transpose()).norm(), 1e-6 * K.norm()) << "a conservative bond's stiffness is symmetric";
+  Eigen::VectorXd scale(n);  // M^-1/2
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (int c = 0; c < 3; ++c) scale(6 * i + c) = std::sqrt(p.inv_mass[i]), scale(6 * i + 3 + c) = std::sqrt(p.inv_inertia(i));
+  const Eigen::MatrixXd A = scale.asDiagonal() * (0.5 * (K + K.transpose())) * scale.asDiagonal();
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(A, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
+}
+
+// Two DEs, their axis along no global axis, joined by one bond of each law: the critical step
+// 2 / omega from the block-Gershgorin bound (docs/theory.md#critical-step) is at most 2 / omega_max
+// of the pair's own modes, and not wildly below it. Two pairs: equal radii (1 mm), where the
+// spring's bound is its exact sqrt(2 K / m) (so the bound allows the 1e-9 or so of the central
+// differences) and the cohesive link's rotational rows need their coupling of the two DEs'
+// turns; and 1 and 1.6 mm (masses 1 : 4.1), where a row that counts one end's mass alone falls
+// below sqrt(K (1/m_1 + 1/m_2)). Measured ratios of the bound to 2 / omega_max: beam 0.88 and
+// 0.80, spring 1.0 and 0.91, cohesive link 0.93 and 0.85.
+TEST(CriticalStep, BoundsThePairsHighestFrequencyForEveryBondLaw) {
+  for (const double R2 : {1e-3, 1.6e-3}) {
+    const double R1 = 1e-3;
+    std::vector<std::pair<std::string, std::unique_ptr<BondSet>>> laws;
+    laws.emplace_back("beam", std::make_unique<BeamBondSet>(beam));
+    laws.emplace_back("spring", std::make_unique<SpringBondSet>(1e7, 0.0));
+    CohesiveContactSet::Parameters cohesive;
+    cohesive.strength_normal = cohesive.strength_shear = 5e7;
+    cohesive.toughness_I = cohesive.toughness_II = 300.0;
+    cohesive.stiffness = 1e15;
+    laws.emplace_back("cohesive", std::make_unique<CohesiveContactSet>(cohesive));
+    for (auto& [name, set] : laws) {
+      SCOPED_TRACE(name + ", R2 = " + std::to_string(R2));
+      DemModel model;
+      model.particles.add({0, 0, 0}, R1, steel);
+      model.particles.add(Vec3{0.6, -0.3, 0.2} * ((R1 + R2) / 0.7), R2, steel);  // |(0.6, -0.3, 0.2)| = 0.7
+      set->add(0, 1, model.particles);
+      model.add_bond_set(std::move(set));
+      model.finalize();
+      const double bound = model.critical_time_step(), exact = 2.0 / highest_frequency(model);
+      EXPECT_LE(bound, exact * (1.0 + 1e-6));
+      EXPECT_GT(bound, 0.75 * exact);
+    }
+  }
+}
+
+// Two DEs in penalty contact (stiffness K, one neighbour each): the pair's only mode has
+// omega^2 = K (1/m_1 + 1/m_2); the contact law's bound K (1/m_i + 1/sqrt(m_i m_min)) gives it
+// exactly for equal masses (so the bound allows round-off) and 0.79 of 2 / omega for radii 1 and
+// 1.6 mm.
+TEST(CriticalStep, BoundsAContactPairsFrequency) {
+  const double K = 1e6;  // N/m
+  for (const double R2 : {1e-3, 1.6e-3}) {
+    SCOPED_TRACE(R2);
+    const double R1 = 1e-3;
+    DemModel model;
+    model.particles.add({0, 0, 0}, R1, steel);
+    model.particles.add({0.999 * (R1 + R2), 0, 0}, R2, steel);
+    model.set_contact(std::make_unique<PenaltyContact>(K), 0.2 * R1);
+    model.finalize();
+    const double exact = 2.0 / std::sqrt(K * (model.particles.inv_mass[0] + model.particles.inv_mass[1]));
+    EXPECT_LE(model.critical_time_step(), exact * (1.0 + 1e-12));
+    EXPECT_GT(model.critical_time_step(), 0.75 * exact);
+  }
 }
 
 // Viscous damping applied from the half-step velocity multiplies a free DE's half-step velocity
