@@ -2,7 +2,7 @@
 // Verification of the explicit step against closed forms: free flight and spin, a bonded
 // pair's axial frequency, energy drift and momentum conservation of a bonded block, the
 // long-wave speed of a bonded chain, and an elastic head-on contact; the critical step's bound
-// against a bonded pair's eigenvalues.
+// against a bonded pair's eigenvalues and a contact pair's frequency.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -435,7 +435,8 @@ TEST_F(BondedPair, CriticalTimeStepBoundsTheTrueFrequency) {
 // about the global axes, to which the torques are conjugate), M = diag(m, m, m, I, I, I) per
 // DE, and omega_max^2 the largest eigenvalue of M^-1/2 K M^-1/2.
 double highest_frequency(const DemModel& model) {
-  ParticleSet p = model.particles;
+  const ParticleSet& start = model.particles;
+  ParticleSet p = start;
   const int n = 6 * static_cast<int>(p.size());
   const auto actions = [&] {
     p.clear_forces();
@@ -450,7 +451,6 @@ double highest_frequency(const DemModel& model) {
     const std::size_t i = static_cast<std::size_t>(d / 6);
     const int c = d % 6;
     const double h = c < 3 ? 1e-7 * p.radius[i] : 1e-7;
-    const ParticleSet start = p;
     const auto moved = [&](double by) {
       p = start;
       Vec3 e{};
@@ -460,7 +460,6 @@ double highest_frequency(const DemModel& model) {
       return actions();
     };
     K.col(d) = (moved(-h) - moved(h)) / (2.0 * h);
-    p = start;
   }
   EXPECT_LT((K - K.transpose()).norm(), 1e-6 * K.norm()) << "a conservative bond's stiffness is symmetric";
   Eigen::VectorXd scale(n);  // M^-1/2
