@@ -208,6 +208,24 @@ TEST(ContinuumNem, PatchTest) {
     }
 }
 
+// The integration points are the sub-cells' centroids with their volumes: their rule integrates 1
+// and x exactly over the domain (the unit cube: volume 1, centroid (1/2, 1/2, 1/2)), as the
+// sub-cells tile it. Measured: round-off, 1.1e-15 (bound 2e-14); a point put off its sub-cell's
+// centroid (at its face triangle's, say) moves the first moment by 4e-5 on this mesh.
+TEST(ContinuumNem, IntegrationPointsIntegrateTheDomainsVolumeAndFirstMoment) {
+  const auto s = make_nem(0.3, "sibson");
+  double volume = 0.0;
+  Vec3 moment{};
+  for (std::size_t q = 0; q < s->point_positions().size(); ++q) {
+    volume += s->point_weights()[q];
+    moment += s->point_weights()[q] * s->point_positions()[q];
+  }
+  std::printf("nem points: sum V_q = %.17g, sum V_q x_q - (1/2, 1/2, 1/2) = (%.1e, %.1e, %.1e)\n", volume, moment.x - 0.5,
+              moment.y - 0.5, moment.z - 0.5);
+  EXPECT_NEAR(volume, 1.0, 2e-14);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(moment[k], 0.5, 2e-14) << "component " << k;
+}
+
 TEST(ContinuumNem, LumpedMassAndStableExplicitSteps) {
   auto s = make_nem(0.3, "sibson");
   double m = 0;

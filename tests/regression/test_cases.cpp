@@ -1085,6 +1085,13 @@ TEST(Cases, DamageInTheOverlapStopsOrWarnsAndDamageElsewhereDoesNot) {
   EXPECT_EQ(w.at("status").get<std::string>(), "completed");
   EXPECT_GT(w.at("damage_in_overlap_breaks").get<long>(), s.at("damage_in_overlap_breaks").get<long>());
 
+  // Any weight below 1 is the overlap's: with a constant DEM weight of 0.9 there, a bond breaking
+  // next to the pure-DEM zone stops the run as well.
+  const auto near_one = test::run_arlequin(patch + "--set coupling.weight=constant --set coupling.constant_value=0.9 --out " +
+                                           (out / "near_one").string());
+  EXPECT_EQ(near_one.exit_code, 3) << near_one.output;
+  EXPECT_NE(near_one.output.find("where the DEM's weight is 0.9 "), std::string::npos) << near_one.output;
+
   // A tensile pulse breaking bonds in the pure-DEM zone of the wave bar, the overlap far ahead.
   const auto elsewhere = test::run_arlequin(
       "run " + cases + "wave_bar_coupled/case.yaml --quiet --set output.fields=[] --set checks=[] --set time.end=3e-5 "
@@ -1166,7 +1173,8 @@ TEST(Cli, CompareBoundsTheCoupledErrorAndHonoursChecks) {
 
 // A single comparison reports the first break's relative difference where both runs broke (the
 // figure compare prints): the lattice bar against itself with bonds of 90 instead of 200 MPa,
-// which break earlier under the same slow stretch.
+// which break earlier under the same slow stretch. And its speed-up: of the time loops less their
+// output.
 TEST(Cli, CompareReportsTheFirstBreaksRelativeDifference) {
   const auto out = test::scratch_dir("compare_first_break");
   const auto r = test::run_arlequin("compare " + cases + "lattice_bar_failure/case.yaml " + cases + "lattice_bar_failure/case.yaml"
@@ -1179,6 +1187,15 @@ TEST(Cli, CompareReportsTheFirstBreaksRelativeDifference) {
   EXPECT_LT(t_other, t_reference);
   EXPECT_DOUBLE_EQ(c.at("first_break_relative_difference").get<double>(), (t_other - t_reference) / t_reference);
   EXPECT_FALSE(c.contains("ensemble"));
+  // Each run's compute time from its summary.json.
+  double compute[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string side = k == 0 ? "reference" : "other";
+    const Json wall = read_json_file(out / side / "summary.json").at("wall_time");
+    compute[k] = c.at(side).at("compute_seconds").get<double>();
+    EXPECT_DOUBLE_EQ(compute[k], wall.at("time_loop").get<double>() - wall.at("output").get<double>()) << side;
+  }
+  EXPECT_DOUBLE_EQ(c.at("speedup_compute").get<double>(), compute[0] / compute[1]);
 }
 
 // compare --ensemble: pairs of runs with both time steps moved by k 1e-9 (docs/decisions.md#d44).

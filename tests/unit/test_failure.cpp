@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Bond failure against closed forms: BBF thresholds in pure tension and pure bending, springs at
+// Bond failure against closed forms: BBF thresholds in pure tension and pure bending, the mode a
+// break reports (torsion, and shear where a pair is closer than half its beam radius), springs at
 // their maximum elongation, no force after a break, the RDEF virial stress of a uniformly
 // strained lattice, the largest principal and von Mises stresses of rotated principal values,
 // RDEF breaking every bond of a DE, its average weighted by the DEs' volumes, and contact
@@ -75,6 +76,39 @@ TEST_F(BreakablePair, BreaksExactlyAtTheThresholdInPureBending) {
   const auto events = failures();
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].mode, FailureMode::bending);
+}
+
+// The mode a break reports is its largest stress (beam_bond.hpp): |N/S|, r_b |M| / I, the shear
+// stress V/S = 1.5 E r_b^2 |theta_a + theta_b| / L0^2 and the torsion stress G r_b |phi| / L0.
+TEST_F(BreakablePair, ReportsTheLargestStressAsItsMode) {
+  // Stretched just past the threshold (N / S = sigma_f, the criterion's only term here) and
+  // twisted by phi with G r_b phi / L0 = 1.5 sigma_f: torsion.
+  p.position[1].x = R1Beam::L * (1.0 + sigma_f / R1Beam::E * (1.0 + 1e-9));
+  p.orientation[1] = from_rotation_vector({1.5 * sigma_f * R1Beam::L / (R1Beam::G * R1Beam::rb), 0.0, 0.0});
+  const auto twisted = failures();
+  ASSERT_EQ(twisted.size(), 1u);
+  EXPECT_EQ(twisted[0].mode, FailureMode::torsion);
+}
+
+// Shear exceeds bending only where r_b > 2 L0: with both ends' rotations locked and DE j moved
+// sideways, theta_a = theta_b = theta, bending 6 E r_b |theta| / L0 and shear 3 E r_b^2 |theta| / L0^2.
+// A pair 0.4 R apart with r_mu = 1.9 (r_b / (2 L0) = 2.375), bent to twice the threshold: shear.
+TEST(BeamFailureMode, ShearDominatesAPairCloserThanHalfItsBeamRadius) {
+  constexpr double sigma_f = 200.0, L0 = 0.4;
+  ParticleSet p;
+  p.add({0, 0, 0}, R1Beam::R, 1.0);
+  p.add({L0, 0, 0}, R1Beam::R, 1.0);
+  BeamBondSet beam{{R1Beam::E, R1Beam::nu, 1.9, sigma_f}};
+  beam.add(0, 1, p);
+  beam.finalize(2);
+  const double theta = 2.0 * sigma_f * L0 / (6.0 * R1Beam::E * 1.9 * R1Beam::R);
+  p.position[1].y = L0 * std::tan(theta);
+  p.clear_forces();
+  beam.accumulate_forces(p, criterion_scan());
+  std::vector<BreakEvent> events;
+  beam.find_failures(p, 0, 0.0, events);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].mode, FailureMode::shear);
 }
 
 TEST_F(BreakablePair, ABrokenBondCarriesNoForce) {
