@@ -212,6 +212,17 @@ TEST(Dcb, ReducedDcbPropagatesAlongLefmAndBalancesEnergy) {
     mix += std::stod(e.at("mode_mix"));
   }
   EXPECT_LT(mix / breaks.size(), 0.45);  // opening-dominated: measured 0.33 (the arms' rotation slides the faces)
+  // The crack sensors by their definitions (docs/theory.md#crack-measures), to the CSV's 12
+  // digits: broken zone = a - a(0), softening zone = damage front - a(0), and the process zone
+  // between them, damage front - a, never negative (the damage front leads the tip).
+  const auto rows = test::read_csv(out / "series.csv");
+  const double a_start = at(rows.front(), "a");
+  for (const auto& row : rows) {
+    EXPECT_NEAR(at(row, "broken_zone"), at(row, "a") - a_start, 2e-12) << row.at("time");
+    EXPECT_NEAR(at(row, "softening_zone"), at(row, "damage_front") - a_start, 2e-12) << row.at("time");
+    EXPECT_NEAR(at(row, "process_zone"), at(row, "damage_front") - at(row, "a"), 2e-12) << row.at("time");
+    EXPECT_GE(at(row, "process_zone"), 0.0) << row.at("time");
+  }
 }
 
 // The coupled DCB (cases/dcb_coupled) on the reduced DCB's packing (radius 2.8e-4 m) and the

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numbers>
 
 #include "app/runner.hpp"
 #include "app/virtual_tests.hpp"
@@ -104,6 +105,36 @@ TEST(VirtualTests, HomogeneousPackingIsIsotropicAndScalesWithEmu) {
   const double G = z.modulus.value / (2.0 * (1.0 + z.poisson[0].value));
   EXPECT_LT(shear.modulus.value, G);
   EXPECT_GT(shear.modulus.value, 0.5 * G);
+}
+
+// The time scale's affine estimate (virtual_tests.hpp), M = 2 W / (eps^2 V), against its closed
+// forms on a simple-cubic lattice of n^3 DEs (radius R, spacing a = 2R, box V = (n a)^3, beam
+// bonds of radius r_b = r_mu R): tension along z stretches only the (n - 1) n^2 z-bonds,
+// W = (n - 1) n^2 E S a eps^2 / 2, so M = (n - 1)/n E S / a^2; simple shear u_x = gamma z tilts
+// them with the DEs unturned, theta_a = theta_b = gamma, W = (n - 1) n^2 (2 E I / a) 3 gamma^2,
+// so M = 12 (n - 1)/n E I / a^4. Measured: 4e-11 and 1e-10 of them (the stretch, eps a, is
+// the difference of two lengths 1e6 times larger); bound 1e-9.
+TEST(VirtualTests, AffineEstimatesOfALatticeAreItsBondsClosedForms) {
+  const auto dir = test::scratch_dir("virtual_tests_affine");
+  write(dir / "lattice.yaml",
+        "name: lattice\n"
+        "time: {end: 1.0e-6}\n"
+        "dem:\n"
+        "  sample: {build: lattice, origin: [0, 0, 0], counts: [4, 4, 4], radius: 1.0e-3}\n"
+        "  density: 7800\n"
+        "  bond: {law: beam, E_mu: 2.0e11, nu_mu: 0.3, r_mu: 0.5}\n");
+  write(dir / "spec.yaml", "case: lattice.yaml\ntests: [{name: L, tension: z}, {name: S, shear: [z, x]}]\n");
+  const auto r = test::run_arlequin("virtual-test " + (dir / "spec.yaml").string() + " --out " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double n = 4, E = 2e11, a = 2e-3, rb = 0.5e-3;
+  const double S = std::numbers::pi * rb * rb, I = 0.25 * std::numbers::pi * rb * rb * rb * rb;
+  const double tension = read_json_file(dir / "out" / "base" / "L" / "test.json").at("modulus_estimate").get<double>();
+  const double shear = read_json_file(dir / "out" / "base" / "S" / "test.json").at("modulus_estimate").get<double>();
+  const double tension_closed = (n - 1) / n * E * S / (a * a), shear_closed = 12.0 * (n - 1) / n * E * I / (a * a * a * a);
+  std::printf("affine estimates / closed forms - 1: tension %.1e, shear %.1e\n", tension / tension_closed - 1.0,
+              shear / shear_closed - 1.0);
+  EXPECT_NEAR(tension / tension_closed, 1.0, 1e-9);
+  EXPECT_NEAR(shear / shear_closed, 1.0, 1e-9);
 }
 
 // A coarse calibration through the command line: the pair hits the target on its packing, the

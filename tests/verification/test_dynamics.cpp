@@ -101,6 +101,27 @@ struct BondedPair : ::testing::Test {
   }
 };
 
+// The energy sensor of a group: its DEs' kinetic energy and half the energy of each bond they
+// hold. Stretched by delta, the pair's bond holds k delta^2 / 2 (k = E S / L0): DE 0's group
+// gets a quarter of k delta^2 with its own kinetic energy, the pair's group both DEs' and the
+// whole bond, which is the model's total. Measured: 5e-15 of each; bound 2e-13 of the total
+// (the stretch is the difference of two lengths 200 times larger).
+TEST_F(BondedPair, AGroupsEnergyIsItsKineticEnergyAndHalfOfEachOfItsBonds) {
+  const int left = model.add_group("left", {0}), both = model.add_group("both", {0, 1});
+  model.finalize();
+  const double delta = 1e-5, k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+  model.particles.position[1].x += delta;
+  model.particles.velocity[0] = {-0.2, 0.0, 0.0};
+  model.particles.velocity[1] = {0.0, 0.3, 0.0};
+  const double m = model.particles.mass(0), bond = 0.5 * k * delta * delta, total = model.energies().total();
+  const double left_closed = 0.5 * bond + 0.5 * m * 0.04, both_closed = bond + 0.5 * m * (0.04 + 0.09);
+  std::printf("group energies / closed forms - 1: one DE %.1e, both %.1e\n", model.group_energy(left) / left_closed - 1.0,
+              model.group_energy(both) / both_closed - 1.0);
+  EXPECT_NEAR(model.group_energy(left), left_closed, 2e-13 * total);
+  EXPECT_NEAR(model.group_energy(both), both_closed, 2e-13 * total);
+  EXPECT_NEAR(model.group_energy(both), total, 1e-14 * total);
+}
+
 TEST_F(BondedPair, AxialOscillationAtTheClosedFormFrequency) {
   model.particles.velocity[0] = {-1e-3, 0, 0};
   model.particles.velocity[1] = {1e-3, 0, 0};
