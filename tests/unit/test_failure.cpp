@@ -33,6 +33,15 @@ ForceScan criterion_scan() {
 
 using test::R1Beam;
 
+// The failures one beam set reports after a force pass with the failure scan, as in a step.
+std::vector<BreakEvent> failures_of(BeamBondSet& beam, ParticleSet& p) {
+  p.clear_forces();
+  beam.accumulate_forces(p, criterion_scan());
+  std::vector<BreakEvent> events;
+  beam.find_failures(p, 0, 0.0, events);
+  return events;
+}
+
 struct BreakablePair : ::testing::Test {
   static constexpr double sigma_f = 200.0;  // N/mm^2 (R1 units)
   ParticleSet p;
@@ -43,14 +52,7 @@ struct BreakablePair : ::testing::Test {
     beam.add(0, 1, p);
     beam.finalize(2);
   }
-  // The check reads the measures of the last force pass with a failure scan, as in a step.
-  std::vector<BreakEvent> failures() {
-    p.clear_forces();
-    beam.accumulate_forces(p, criterion_scan());
-    std::vector<BreakEvent> events;
-    beam.find_failures(p, 0, 0.0, events);
-    return events;
-  }
+  std::vector<BreakEvent> failures() { return failures_of(beam, p); }
 };
 
 TEST_F(BreakablePair, BreaksExactlyAtTheThresholdInPureTension) {
@@ -103,10 +105,7 @@ TEST(BeamFailureMode, ShearDominatesAPairCloserThanHalfItsBeamRadius) {
   beam.finalize(2);
   const double theta = 2.0 * sigma_f * L0 / (6.0 * R1Beam::E * 1.9 * R1Beam::R);
   p.position[1].y = L0 * std::tan(theta);
-  p.clear_forces();
-  beam.accumulate_forces(p, criterion_scan());
-  std::vector<BreakEvent> events;
-  beam.find_failures(p, 0, 0.0, events);
+  const auto events = failures_of(beam, p);
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].mode, FailureMode::shear);
 }

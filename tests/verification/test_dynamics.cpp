@@ -91,13 +91,14 @@ TEST(FreeMotion, DesDriftTheSameInABlockAndAlone) {
 struct BondedPair : ::testing::Test {
   static constexpr double R = 1e-3;
   DemModel model;
+  double axial_stiffness = 0.0;  // E S / L0, N/m
   double omega_axial = 0.0;
   void SetUp() override {
     model.particles.add({0, 0, 0}, R, steel);
     model.particles.add({2 * R, 0, 0}, R, steel);
     test::bond_all_touching(model, beam);
-    const double k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
-    omega_axial = std::sqrt(2.0 * k / model.particles.mass(0));
+    axial_stiffness = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+    omega_axial = std::sqrt(2.0 * axial_stiffness / model.particles.mass(0));
   }
 };
 
@@ -109,11 +110,11 @@ struct BondedPair : ::testing::Test {
 TEST_F(BondedPair, AGroupsEnergyIsItsKineticEnergyAndHalfOfEachOfItsBonds) {
   const int left = model.add_group("left", {0}), both = model.add_group("both", {0, 1});
   model.finalize();
-  const double delta = 1e-5, k = beam.young * std::numbers::pi * std::pow(beam.radius_ratio * R, 2) / (2 * R);
+  const double delta = 1e-5;
   model.particles.position[1].x += delta;
   model.particles.velocity[0] = {-0.2, 0.0, 0.0};
   model.particles.velocity[1] = {0.0, 0.3, 0.0};
-  const double m = model.particles.mass(0), bond = 0.5 * k * delta * delta, total = model.energies().total();
+  const double m = model.particles.mass(0), bond = 0.5 * axial_stiffness * delta * delta, total = model.energies().total();
   const double left_closed = 0.5 * bond + 0.5 * m * 0.04, both_closed = bond + 0.5 * m * (0.04 + 0.09);
   std::printf("group energies / closed forms - 1: one DE %.1e, both %.1e\n", model.group_energy(left) / left_closed - 1.0,
               model.group_energy(both) / both_closed - 1.0);
